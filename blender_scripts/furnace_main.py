@@ -1,0 +1,415 @@
+# ---------------------------------------------------------------------------
+# furnace_main.py: the "main" of gloffuse's verify job.
+#
+# Appended by the gloffuse binary after a header that defines GLOFFUSE_PARAMS
+# (the parameter document as a JSON string) and after groups_lib.py (which
+# provides build_all(params) and blender_version_string()).
+#
+# It builds a white furnace: a white world of strength 1, an orthographic
+# camera looking down -Z at a grid of white spheres (one cell per sphere, row 0
+# at the top of the image), each sphere visible to camera rays only so that it
+# sees nothing but the world. One Cycles render of the whole grid is written as
+# a single-layer, 32-bit float, ZIP-compressed OpenEXR (scene-linear RGBA,
+# premultiplied by coverage because the film is transparent), and one line
+#   GLOFFUSE_RESULT {json}
+# is printed to stdout at the end.
+#
+#   blender -b --factory-startup -noaudio --python-exit-code 1 --python THIS.py -- [--output OUT.exr]
+#   python3 THIS.py [--output OUT.exr]        (with the bpy module)
+# The only argument, --output, overrides furnace.output. Uses the library's
+# script_args, result_line and run_main; on any error it prints a traceback
+# and exits 1.
+# ---------------------------------------------------------------------------
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import bmesh
+import bpy
+
+FURNACE_PLAIN_DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY", "MULTI_GGX")
+
+# Each sphere is the upper half (plus one ring) of a UV sphere with this many
+# segments and rings (counted on the full sphere). The sphere's mean converges
+# to E_avg as 1/rings^2, driven by the radial resolution near the silhouette:
+# measured in 4.5 (1024 spp), the GGX/Ashikhmin-Shirley r=1 means come out
+# +0.07 % high with 64 rings and within 0.01-0.02 % of a 512 x 256 sphere with
+# 128 x 128, at the triangle count of a full 128 x 64 sphere.
+FURNACE_SPHERE_SEGMENTS = 128
+FURNACE_SPHERE_RINGS = 128
+
+# One world unit per grid cell; the camera sits well above the spheres.
+FURNACE_CAMERA_HEIGHT = 10.0
+
+
+class FurnaceParamsError(ValueError):
+    """The parameter document's "furnace" section is missing or malformed."""
+
+
+# --- arguments and parameters ------------------------------------------------
+
+def parse_furnace_args(args):
+    parser = argparse.ArgumentParser(
+        prog="gloffuse-furnace",
+        description="Render the gloffuse furnace grid described by the embedded parameters.")
+    parser.add_argument("--output", metavar="OUT.exr",
+                        help="write the EXR here instead of furnace.output")
+    return parser.parse_args(args)
+
+
+def furnace_require(cond, message):
+    if not cond:
+        raise FurnaceParamsError("furnace parameters: " + message)
+
+
+def furnace_number(section, key, kind, low, high=None):
+    value = section.get(key)
+    furnace_require(isinstance(value, (int, float)) and not isinstance(value, bool),
+                    "%r must be a number, got %r" % (key, value))
+    furnace_require(kind is float or float(value).is_integer(),
+                    "%r must be an integer, got %r" % (key, value))
+    value = kind(value)
+    furnace_require(value >= low and (high is None or value <= high),
+                    "%r = %r is outside [%r, %s]" % (key, value, low, "inf" if high is None else high))
+    return value
+
+
+def furnace_sphere_spec(index, sphere):
+    """Check one sphere entry and return a normalised copy."""
+    where = "spheres[%d]" % index
+    furnace_require(isinstance(sphere, dict), "%s must be an object" % where)
+    roughness = furnace_number(sphere, "roughness", float, 0.0, 1.0)
+    shader = sphere.get("shader")
+    if shader == "plain":
+        distribution = sphere.get("distribution")
+        furnace_require(distribution in FURNACE_PLAIN_DISTRIBUTIONS,
+                        "%s.distribution must be one of %s, got %r"
+                        % (where, ", ".join(FURNACE_PLAIN_DISTRIBUTIONS), distribution))
+        return {"shader": "plain", "distribution": distribution, "roughness": roughness}
+    if shader == "group":
+        group = sphere.get("group")
+        furnace_require(isinstance(group, str) and group != "",
+                        "%s.group must be a node group name" % where)
+        return {"shader": "group", "group": group, "roughness": roughness}
+    raise FurnaceParamsError("furnace parameters: %s.shader must be \"plain\" or \"group\", got %r"
+                             % (where, shader))
+
+
+def furnace_params(document):
+    """The validated "furnace" section of the parameter document."""
+    furnace_require(isinstance(document, dict), "the parameter document must be an object")
+    section = document.get("furnace")
+    furnace_require(isinstance(section, dict), "the document has no \"furnace\" object")
+    output = section.get("output")
+    furnace_require(isinstance(output, str) and output != "", "\"output\" must be a file path")
+    spheres = section.get("spheres")
+    furnace_require(isinstance(spheres, list) and spheres, "\"spheres\" must be a non-empty list")
+    return {
+        "cell": furnace_number(section, "cell", int, 4),
+        "columns": furnace_number(section, "columns", int, 1),
+        "samples": furnace_number(section, "samples", int, 1),
+        "seed": furnace_number(section, "seed", int, 0),
+        "radius_fraction": furnace_number(section, "radius_fraction", float, 0.05, 1.0),
+        "threads": furnace_number(section, "threads", int, 0),
+        "output": output,
+        "spheres": [furnace_sphere_spec(i, s) for i, s in enumerate(spheres)],
+    }
+
+
+def furnace_grid(furnace):
+    """(columns, rows) of the grid; row-major, row 0 at the top."""
+    columns = furnace["columns"]
+    rows = (len(furnace["spheres"]) + columns - 1) // columns
+    return columns, rows
+
+
+# --- compatibility shim (3.x / 4.x / 5.x) ------------------------------------
+
+def compat_node_tree(id_block):
+    """The node tree of a world or material, creating it where needed.
+    3.x/4.x: node_tree is None until use_nodes is set; 5.0: always present and
+    use_nodes is deprecated, so it is only touched when there is no tree."""
+    if id_block.node_tree is None and hasattr(id_block, "use_nodes"):
+        id_block.use_nodes = True
+    if id_block.node_tree is None:
+        raise RuntimeError("%s %r has no node tree" % (type(id_block).__name__, id_block.name))
+    return id_block.node_tree
+
+
+def compat_camera_rays_only(obj):
+    """Make an object visible to camera rays only (3.0+: Object.visible_*;
+    2.9x: Object.cycles_visibility.*)."""
+    flags = {"camera": True, "diffuse": False, "glossy": False, "transmission": False,
+             "volume_scatter": False, "shadow": False}
+    if hasattr(obj, "visible_diffuse"):
+        for name, value in flags.items():
+            setattr(obj, "visible_" + name, value)
+    else:
+        visibility = obj.cycles_visibility
+        for name, value in flags.items():
+            key = "scatter" if name == "volume_scatter" else name
+            if hasattr(visibility, key):
+                setattr(visibility, key, value)
+
+
+def compat_disable_denoising(scene):
+    scene.cycles.use_denoising = False
+    for view_layer in scene.view_layers:
+        if hasattr(view_layer, "cycles") and hasattr(view_layer.cycles, "use_denoising"):
+            view_layer.cycles.use_denoising = False
+
+
+def compat_exr_settings(settings):
+    """Single-layer OpenEXR, RGBA, 32-bit float, ZIP (the exr crate reads ZIP,
+    not DWAA/DWAB). 5.0 needs media_type before file_format."""
+    if hasattr(settings, "media_type"):
+        settings.media_type = "IMAGE"
+    settings.file_format = "OPEN_EXR"
+    settings.color_mode = "RGBA"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    if hasattr(settings, "use_zbuffer"):
+        settings.use_zbuffer = False
+    if hasattr(settings, "use_preview"):
+        settings.use_preview = False
+    if hasattr(settings, "color_management"):
+        settings.color_management = "FOLLOW_SCENE"
+
+
+def compat_uv_sphere(bm, radius):
+    # bmesh's create_uvsphere takes `radius` since 3.0 (`diameter`, which was
+    # really a radius, before).
+    try:
+        bmesh.ops.create_uvsphere(bm, u_segments=FURNACE_SPHERE_SEGMENTS,
+                                  v_segments=FURNACE_SPHERE_RINGS, radius=radius)
+    except TypeError:
+        bmesh.ops.create_uvsphere(bm, u_segments=FURNACE_SPHERE_SEGMENTS,
+                                  v_segments=FURNACE_SPHERE_RINGS, diameter=radius)
+
+
+def compat_disable_post_processing(render):
+    for name in ("use_compositing", "use_sequencer"):
+        if hasattr(render, name):
+            setattr(render, name, False)
+
+
+# --- scene ---------------------------------------------------------------------
+
+def furnace_world():
+    world = bpy.data.worlds.new("Gloffuse furnace world")
+    tree = compat_node_tree(world)
+    tree.nodes.clear()
+    background = tree.nodes.new("ShaderNodeBackground")
+    background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    output = tree.nodes.new("ShaderNodeOutputWorld")
+    tree.links.new(background.outputs["Background"], output.inputs["Surface"])
+    world.color = (1.0, 1.0, 1.0)
+    return world
+
+
+def furnace_sphere_mesh(radius):
+    """One smooth-shaded UV dome shared by every sphere object; its single
+    material slot is linked per object."""
+    mesh = bpy.data.meshes.new("Gloffuse furnace sphere")
+    bm = bmesh.new()
+    compat_uv_sphere(bm, radius)
+    # The camera looks down -Z and no other ray sees a sphere, so only the
+    # upper half is ever hit: drop the rest (render time grows with the
+    # triangle count: Cycles syncs a separate copy of the mesh for every object
+    # here, the per-object materials keeping it from instancing).
+    # One ring below the equator stays so that the equator's smooth normals
+    # stay horizontal.
+    below = -radius * math.sin(math.pi / FURNACE_SPHERE_RINGS) * 1.001
+    bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.z < below], context="VERTS")
+    bm.to_mesh(mesh)
+    bm.free()
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = False
+    mesh.materials.append(None)
+    mesh.update()
+    return mesh
+
+
+def furnace_group_output(node):
+    if "BSDF" in node.outputs:
+        return node.outputs["BSDF"]
+    for socket in node.outputs:
+        if socket.type == "SHADER":
+            return socket
+    raise RuntimeError("node group %r has no shader output" % node.node_tree.name)
+
+
+def furnace_material(index, sphere):
+    """A white material: a plain Glossy BSDF of the given distribution, or the
+    named gloffuse shader group with Color white."""
+    if sphere["shader"] == "plain":
+        label = "plain %s" % sphere["distribution"]
+    else:
+        label = sphere["group"]
+    material = bpy.data.materials.new("Furnace %03d %s r=%g" % (index, label, sphere["roughness"]))
+    tree = compat_node_tree(material)
+    tree.nodes.clear()
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    output.target = "ALL"
+    if sphere["shader"] == "plain":
+        node = tree.nodes.new("ShaderNodeBsdfGlossy")
+        node.distribution = sphere["distribution"]
+        shader_output = node.outputs["BSDF"]
+    else:
+        group = bpy.data.node_groups.get(sphere["group"])
+        if group is None:
+            raise FurnaceParamsError("furnace parameters: sphere %d uses node group %r, which "
+                                     "was not built (groups: %s)"
+                                     % (index, sphere["group"],
+                                        ", ".join(repr(g.name) for g in bpy.data.node_groups)))
+        node = tree.nodes.new("ShaderNodeGroup")
+        node.node_tree = group
+        shader_output = furnace_group_output(node)
+    node.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    node.inputs["Roughness"].default_value = sphere["roughness"]
+    tree.links.new(shader_output, output.inputs["Surface"])
+    return material
+
+
+def furnace_camera(columns):
+    data = bpy.data.cameras.new("Gloffuse furnace camera")
+    data.type = "ORTHO"
+    data.sensor_fit = "HORIZONTAL"
+    data.ortho_scale = float(columns)  # one world unit per cell
+    data.shift_x = 0.0
+    data.shift_y = 0.0
+    data.clip_start = 0.1
+    data.clip_end = 2.0 * FURNACE_CAMERA_HEIGHT
+    camera = bpy.data.objects.new("Gloffuse furnace camera", data)
+    camera.location = (0.0, 0.0, FURNACE_CAMERA_HEIGHT)
+    camera.rotation_euler = (0.0, 0.0, 0.0)  # looks down -Z, +Y up in the image
+    return camera
+
+
+def furnace_render_settings(scene, furnace, columns, rows):
+    render = scene.render
+    render.engine = "CYCLES"
+    render.resolution_x = columns * furnace["cell"]
+    render.resolution_y = rows * furnace["cell"]
+    render.resolution_percentage = 100
+    render.pixel_aspect_x = 1.0
+    render.pixel_aspect_y = 1.0
+    render.use_border = False
+    render.film_transparent = True
+    compat_disable_post_processing(render)
+    if furnace["threads"] > 0:
+        render.threads_mode = "FIXED"
+        render.threads = furnace["threads"]
+    else:
+        render.threads_mode = "AUTO"
+
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = furnace["samples"]
+    cycles.seed = furnace["seed"]
+    cycles.use_animated_seed = False
+    cycles.use_adaptive_sampling = False
+    if hasattr(cycles, "time_limit"):
+        cycles.time_limit = 0.0
+    # Clamping would bias the estimate; 0 disables it.
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    compat_disable_denoising(scene)
+
+    view = scene.view_settings
+    scene.display_settings.display_device = "sRGB"
+    view.view_transform = "Standard"
+    view.look = "None"
+    view.exposure = 0.0
+    view.gamma = 1.0
+    view.use_curve_mapping = False
+    compat_exr_settings(render.image_settings)
+
+
+def furnace_scene(furnace):
+    """Build the furnace grid in the current (empty) scene and return it."""
+    scene = bpy.context.scene
+    columns, rows = furnace_grid(furnace)
+    furnace_render_settings(scene, furnace, columns, rows)
+    scene.world = furnace_world()
+
+    camera = furnace_camera(columns)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+
+    mesh = furnace_sphere_mesh(0.5 * furnace["radius_fraction"])
+    for index, sphere in enumerate(furnace["spheres"]):
+        column, row = index % columns, index // columns
+        obj = bpy.data.objects.new("Furnace sphere %03d" % index, mesh)
+        obj.location = (column + 0.5 - 0.5 * columns, 0.5 * rows - row - 0.5, 0.0)
+        scene.collection.objects.link(obj)
+        slot = obj.material_slots[0]
+        slot.link = "OBJECT"
+        slot.material = furnace_material(index, sphere)
+        compat_camera_rays_only(obj)
+    return scene
+
+
+def render_result_image():
+    for image in bpy.data.images:
+        if image.type == "RENDER_RESULT":
+            return image
+    raise RuntimeError("rendering produced no Render Result image")
+
+
+def render_sweep(output):
+    """Render the current scene once and save it to `output`; returns render seconds."""
+    directory = os.path.dirname(output)
+    if directory:
+        os.makedirs(directory, exist_ok=True)
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=False)
+    seconds = time.perf_counter() - start
+    # save_render writes the scene's image settings; for OpenEXR that is the
+    # scene-linear result whatever the view transform.
+    # (No scene= argument: in 3.4 passing it leaks an image-format copy and
+    # prints "Error: Not freed memory blocks" at exit.)
+    render_result_image().save_render(filepath=output)
+    if not os.path.isfile(output):
+        raise RuntimeError("Blender did not write %s" % output)
+    return seconds
+
+
+def furnace_main():
+    args = parse_furnace_args(script_args())  # noqa: F821 -- groups_lib.py
+    document = json.loads(GLOFFUSE_PARAMS)  # noqa: F821 -- defined by the generated header
+    furnace = furnace_params(document)
+    output = os.path.abspath(args.output or furnace["output"])
+    if not bpy.app.background:
+        raise RuntimeError("the furnace script starts from an empty factory scene, which "
+                           "would discard the open file: run it headless (blender -b, or "
+                           "python3 with the bpy module)")
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    if document.get("groups"):
+        # A sweep of plain BSDFs only may come without groups; build_all
+        # validates the generate fields (and insists on at least one group).
+        build_all(document)  # noqa: F821 -- groups_lib.py
+    scene = furnace_scene(furnace)
+    seconds = render_sweep(output)
+
+    result = {
+        "blender_version": blender_version_string(),  # noqa: F821 -- groups_lib.py
+        "output": output,
+        "width": scene.render.resolution_x,
+        "height": scene.render.resolution_y,
+        "render_seconds": round(seconds, 3),
+    }
+    print(result_line(result))  # noqa: F821 -- groups_lib.py
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    run_main(furnace_main)  # noqa: F821 -- groups_lib.py: traceback and exit 1 headless

@@ -1,0 +1,46 @@
+# ---------------------------------------------------------------------------
+# gloffuse generate: add or update the node groups in a Blender file.
+#
+#   In Blender's Text Editor (no arguments): updates the groups in the open
+#   file, touches nothing else, does not save.
+#   blender -b --factory-startup -noaudio --python-exit-code 1 --python THIS.py -- [--open IN.blend] [--save OUT.blend]
+#   python3 THIS.py [--open IN.blend] [--save OUT.blend]      (with the bpy module)
+#
+# Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
+# Needs GLOFFUSE_PARAMS (header) and the groups library (above) in the same script.
+# ---------------------------------------------------------------------------
+import argparse
+import sys
+
+
+def parse_generate_args(args):
+    parser = argparse.ArgumentParser(
+        prog="gloffuse-generate",
+        description="Add or update gloffuse's brightness-correction node groups.")
+    parser.add_argument("--open", metavar="IN.blend",
+                        help="open this .blend file first (default: the file already open)")
+    parser.add_argument("--save", metavar="OUT.blend",
+                        help="save the result as this .blend file (default: do not save)")
+    return parser.parse_args(args)
+
+
+def generate_main():
+    options = parse_generate_args(script_args())
+    params = load_params(GLOFFUSE_PARAMS)
+    if options.open:
+        open_blend(options.open)
+    built = build_all(params)
+    saved = save_blend(options.save) if options.save else None
+    names = []
+    for _spec, correction, shader in built:
+        names.extend([correction.name, shader.name])
+    print(result_line({
+        "blender_version": blender_version_string(),
+        "groups": names,
+        "saved": saved,
+    }))
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    run_main(generate_main)

@@ -1,0 +1,160 @@
+//! Command-line definitions (clap). Each flag is documented once, here.
+
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+use crate::blender::BlenderVersion;
+use crate::coefficients::Target;
+use crate::fit::{Point, Weighting};
+use crate::microfacet::{Distribution, Roughness};
+
+const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
+const LONG_ABOUT: &str = "\
+Blender's single-scattering glossy BSDFs (Beckmann, GGX, Ashikhmin-Shirley) lose energy as \
+roughness grows: a white glossy sphere under a white sky should be 100 % bright but comes out \
+far darker when rough. gloffuse measures that loss by integrating exactly the BSDF Cycles \
+evaluates, fits correction curves f(r) (the shader gain is 100/f(r)), and writes them as \
+coefficient files for Blender node groups.
+
+Exit codes: 0 success, 1 a check failed, 2 bad input or a runtime error.";
+
+#[derive(Parser, Debug)]
+#[command(name = "gloffuse", version, about = ABOUT, long_about = LONG_ABOUT)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Albedo of a white Glossy BSDF: E(μ, r) for one view, E_avg(r) for a whole sphere.
+    ///
+    /// E(μ, r) is the fraction of light a white glossy surface of roughness r reflects toward
+    /// a viewer at view cosine μ under a uniform white sky (the centre of a furnace sphere is
+    /// μ = 1). E_avg(r) = 2∫E(μ)μdμ is the mean brightness of the whole sphere.
+    Albedo(AlbedoArgs),
+    /// Fit a correction curve f(r) = 100 + c₂r² + c₃r³ + … (f(0) = 100, f'(0) = 0).
+    ///
+    /// Fits brightness points given by hand (--point ROUGHNESS:PERCENT), or all three
+    /// distributions from the integrator (--from integrator) into a coefficients file. The
+    /// shader gain that restores 100 % is 100/f(r).
+    Fit(FitArgs),
+    /// Inspect coefficient files and the built-in presets.
+    Coefficients {
+        #[command(subcommand)]
+        action: CoefficientsCommand,
+    },
+}
+
+#[derive(Args, Debug)]
+pub struct AlbedoArgs {
+    /// beckmann, ggx or ashikhmin-shirley (case-insensitive; BECKMANN, GGX, ASHIKHMIN_SHIRLEY work too).
+    #[arg(long, short = 'd', value_parser = parse_distribution)]
+    pub distribution: Distribution,
+
+    /// The Glossy node's Roughness, 0 to 1 (Cycles uses alpha = r²).
+    #[arg(long, short = 'r', value_parser = parse_roughness)]
+    pub roughness: Option<Roughness>,
+
+    /// View cosine μ = N·V in (0, 1]; 1 looks straight at the surface (a sphere's centre).
+    #[arg(long, default_value = "1", value_parser = parse_mu)]
+    pub mu: f64,
+
+    /// Blender version whose masking to model: 3.0–3.5 separable, 3.6 and later height-correlated.
+    #[arg(long, default_value = "4.5", value_parser = parse_version)]
+    pub blender_version: BlenderVersion,
+
+    /// Write a CSV grid instead: roughness j/(N−1) for j < N, μ = (i + ½)/N for i < N.
+    #[arg(long, value_name = "FILE.csv")]
+    pub table: Option<PathBuf>,
+
+    /// Grid size N for --table.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=4096))]
+    pub grid: u32,
+
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FitSource {
+    /// gloffuse's integrator (exactly the BSDF Cycles evaluates).
+    Integrator,
+}
+
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// Distribution the --point values belong to (beckmann, ggx, ashikhmin-shirley).
+    #[arg(long, short = 'd', value_parser = parse_distribution)]
+    pub distribution: Option<Distribution>,
+
+    /// A measured brightness, ROUGHNESS:PERCENT (e.g. 0.5:97); repeat for more points.
+    #[arg(long = "point", short = 'p', value_name = "R:PERCENT", value_parser = parse_point, conflicts_with = "from")]
+    pub points: Vec<Point>,
+
+    /// Fit every distribution from this source instead of --point values.
+    #[arg(long, value_enum)]
+    pub from: Option<FitSource>,
+
+    /// Polynomial degree in r, 2 to 8 [default: 3 for --point, 6 for --from integrator, the
+    /// lowest degree that keeps every distribution's gain within 0.1 %].
+    #[arg(long)]
+    pub degree: Option<usize>,
+
+    /// Minimise the error in brightness points (absolute) or in the gain 100/f (relative).
+    #[arg(long, value_enum, default_value = "relative")]
+    pub weighting: Weighting,
+
+    /// With --from integrator: fit the sphere's mean brightness E_avg(r) or its centre E(1, r).
+    #[arg(long, value_enum, default_value = "mean")]
+    pub target: Target,
+
+    /// With --from integrator: the Blender version whose masking to model.
+    #[arg(long, default_value = "4.5", value_parser = parse_version)]
+    pub blender_version: BlenderVersion,
+
+    /// Write a coefficients file (written atomically: never half-written).
+    #[arg(long, value_name = "FILE.json")]
+    pub out: Option<PathBuf>,
+
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum CoefficientsCommand {
+    /// Print a readable summary of a preset or coefficients file (no argument: list presets).
+    Show {
+        /// A preset name (seed, blender-3, blender-4) or a path to a coefficients file.
+        #[arg(value_name = "PRESET|FILE")]
+        source: Option<String>,
+        /// Print the validated file as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn parse_distribution(s: &str) -> Result<Distribution, String> {
+    s.parse().map_err(|e: crate::Error| e.to_string())
+}
+
+fn parse_roughness(s: &str) -> Result<Roughness, String> {
+    s.parse().map_err(|e: crate::Error| e.to_string())
+}
+
+fn parse_version(s: &str) -> Result<BlenderVersion, String> {
+    s.parse().map_err(|e: crate::Error| e.to_string())
+}
+
+fn parse_point(s: &str) -> Result<Point, String> {
+    s.parse().map_err(|e: crate::Error| e.to_string())
+}
+
+fn parse_mu(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 1.0 => Ok(v),
+        _ => Err(format!("invalid view cosine '{s}': expected a number in (0, 1], e.g. 1 or 0.5")),
+    }
+}

@@ -1,0 +1,15 @@
+//! gloffuse: measure, fit and correct the energy loss of Blender's glossy BSDFs.
+//!
+//! Data flows one way: [`microfacet`] (measure) → [`fit`] → [`coefficients`] → generate →
+//! verify → report.
+
+pub mod app;
+pub mod blender;
+pub mod cli;
+pub mod coefficients;
+pub mod error;
+pub mod fit;
+pub mod microfacet;
+pub mod output;
+
+pub use error::{Error, Result};
