@@ -53,11 +53,11 @@ pub struct AlbedoArgs {
     pub distribution: Distribution,
 
     /// The Glossy node's Roughness, 0 to 1 (Cycles uses alpha = r²).
-    #[arg(long, short = 'r', value_parser = parse_roughness)]
+    #[arg(long, short = 'r', value_parser = parse_roughness, allow_hyphen_values = true)]
     pub roughness: Option<Roughness>,
 
     /// View cosine μ = N·V in (0, 1]; 1 looks straight at the surface (a sphere's centre).
-    #[arg(long, default_value = "1", value_parser = parse_mu)]
+    #[arg(long, default_value = "1", value_parser = parse_mu, allow_hyphen_values = true)]
     pub mu: f64,
 
     /// Blender version whose masking to model: 3.0–3.5 separable, 3.6 and later height-correlated.
@@ -90,7 +90,7 @@ pub struct FitArgs {
     pub distribution: Option<Distribution>,
 
     /// A measured brightness, ROUGHNESS:PERCENT (e.g. 0.5:97); repeat for more points.
-    #[arg(long = "point", short = 'p', value_name = "R:PERCENT", value_parser = parse_point, conflicts_with = "from")]
+    #[arg(long = "point", short = 'p', value_name = "R:PERCENT", value_parser = parse_point, conflicts_with = "from", allow_hyphen_values = true)]
     pub points: Vec<Point>,
 
     /// Fit every distribution from this source instead of --point values.

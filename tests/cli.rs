@@ -1,0 +1,207 @@
+//! The `gloffuse` binary driven as a user would, including bad input: every bad input must
+//! exit 2 with a message naming the input, never panic, and never leave a file behind.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use serde_json::Value;
+use std::f64::consts::LN_2;
+
+fn gloffuse() -> Command {
+    Command::cargo_bin("gloffuse").unwrap()
+}
+
+fn json_of(args: &[&str]) -> Value {
+    let out = gloffuse().args(args).assert().success().get_output().stdout.clone();
+    serde_json::from_slice(&out).unwrap()
+}
+
+#[test]
+fn help_and_version() {
+    gloffuse().arg("--version").assert().success().stdout(predicate::str::contains(env!("CARGO_PKG_VERSION")));
+    gloffuse()
+        .arg("--help")
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("lose energy").and(predicate::str::contains("Exit codes")));
+    gloffuse().args(["albedo", "--help"]).assert().success().stdout(predicate::str::contains("view cosine"));
+}
+
+#[test]
+fn albedo_matches_closed_forms() {
+    let v = json_of(&["albedo", "--distribution", "GGX", "--roughness", "1", "--json"]);
+    assert!((v["directional_albedo"].as_f64().unwrap() - (1.0 - LN_2)).abs() < 1e-6);
+    assert_eq!(v["masking"], "height-correlated");
+    let v = json_of(&["albedo", "-d", "ASHIKHMIN_SHIRLEY", "-r", "1", "--json", "--blender-version", "3.4"]);
+    assert!((v["directional_albedo"].as_f64().unwrap() - (2f64.sqrt() - 1.0) / 3.0).abs() < 1e-6);
+    assert_eq!(v["masking"], "separable");
+    gloffuse()
+        .args(["albedo", "-d", "ggx", "-r", "1"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("E(mu = 1) = 0.306853"));
+}
+
+#[test]
+fn albedo_table_writes_a_full_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ggx table.csv");
+    gloffuse()
+        .args(["albedo", "-d", "ggx", "--table"])
+        .arg(&path)
+        .args(["--grid", "8"])
+        .assert()
+        .success();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "roughness,mu,albedo,average_albedo");
+    assert_eq!(lines.len(), 1 + 64);
+    for l in &lines[1..] {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        assert!((0.0..=1.0).contains(&v[2]) && (0.0..=1.0).contains(&v[3]));
+        if v[0] == 0.0 {
+            assert_eq!(v[2], 1.0);
+        }
+    }
+}
+
+#[test]
+fn fit_reproduces_the_seed_exactly() {
+    let v = json_of(&["fit", "-d", "beckmann", "-p", "0.5:97", "-p", "1:71", "--json"]);
+    let f = &v["fits"][0];
+    assert!((f["a"].as_f64().unwrap() + 34.0).abs() < 1e-9);
+    assert!((f["b"].as_f64().unwrap() - 5.0).abs() < 1e-9);
+    assert_eq!(f["c"].as_f64().unwrap(), 0.0);
+    assert_eq!(f["d"].as_f64().unwrap(), 100.0);
+    let v = json_of(&["fit", "--distribution", "GGX", "--point", "0.5:85", "--point", "1:59", "--json"]);
+    let f = &v["fits"][0];
+    assert!((f["a"].as_f64().unwrap() - 38.0).abs() < 1e-9);
+    assert!((f["b"].as_f64().unwrap() + 79.0).abs() < 1e-9);
+    gloffuse()
+        .args(["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("a = 38, b = -79, c = 0, d = 100"));
+}
+
+#[test]
+fn fit_from_integrator_writes_a_coefficients_file_that_show_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("coefficients.json");
+    gloffuse()
+        .args(["fit", "--from", "integrator", "--blender-version", "3.4", "--degree", "6", "--out"])
+        .arg(&path)
+        .env("SOURCE_DATE_EPOCH", "0")
+        .assert()
+        .success();
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert_eq!(v["format_version"], 1);
+    assert_eq!(v["distributions"]["ggx"]["masking"], "separable");
+    assert_eq!(v["distributions"]["ggx"]["provenance"]["date"], "1970-01-01");
+    assert!(v["distributions"]["ggx"]["residuals"]["max_gain_error"].as_f64().unwrap() < 1e-3);
+    gloffuse()
+        .args(["coefficients", "show"])
+        .arg(&path)
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("Ashikhmin-Shirley: f(r) ="));
+}
+
+#[test]
+fn coefficients_show_lists_and_reads_presets() {
+    gloffuse()
+        .args(["coefficients", "show"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("seed").and(predicate::str::contains("blender-4")));
+    gloffuse()
+        .args(["coefficients", "show", "seed"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("display-referred"));
+    let v = json_of(&["coefficients", "show", "blender-4", "--json"]);
+    assert_eq!(v["distributions"]["beckmann"]["color_space"], "linear");
+}
+
+/// Each case: arguments, a fragment the error must contain.
+const BAD_INPUT: &[(&[&str], &str)] = &[
+    (&["albedo", "-d", "phong", "-r", "0.5"], "invalid distribution 'phong'"),
+    (&["albedo", "-d", "ggx", "-r", "1.5"], "invalid roughness '1.5'"),
+    (&["albedo", "-d", "ggx", "-r", "-0.1"], "invalid roughness '-0.1'"),
+    (&["albedo", "-d", "ggx", "-r", "NaN"], "invalid roughness 'NaN'"),
+    (&["albedo", "-d", "ggx", "-r", "inf"], "invalid roughness 'inf'"),
+    (&["albedo", "-d", "ggx", "-r", "0.5", "--mu", "0"], "invalid view cosine '0'"),
+    (&["albedo", "-d", "ggx", "-r", "0.5", "--blender-version", "2.79"], "Blender 3.0 or later"),
+    (&["albedo", "-d", "ggx"], "--roughness"),
+    (&["fit", "-d", "ggx", "-p", "0.5"], "invalid point '0.5'"),
+    (&["fit", "-d", "ggx", "-p", "0.5:abc"], "invalid point '0.5:abc'"),
+    (&["fit", "-d", "ggx", "-p", "2:50"], "roughness outside [0, 1]"),
+    (&["fit", "-d", "ggx", "-p", "0.5:NaN"], "invalid point"),
+    (&["fit", "-d", "ggx", "-p", "0.5:85", "-p", "0.5:80"], "duplicate roughness 0.5"),
+    (&["fit", "-d", "ggx", "-p", "0.5:85"], "needs at least 2 points"),
+    (&["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "4"], "needs at least 3 points"),
+    (&["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "9"], "invalid degree '9'"),
+    (&["fit", "-p", "0.5:85", "-p", "1:59"], "--distribution"),
+    (&["coefficients", "show", "no-such-preset"], "no such preset or file"),
+];
+
+#[test]
+fn bad_input_is_refused_clearly() {
+    for (args, fragment) in BAD_INPUT {
+        let out = gloffuse().args(*args).assert().code(2).get_output().clone();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(fragment), "{args:?}: stderr lacks {fragment:?}:\n{stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?} panicked");
+    }
+}
+
+#[test]
+fn unwritable_outputs_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no such dir").join("c.json");
+    gloffuse()
+        .args(["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--out"])
+        .arg(&missing)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("does not exist"));
+    gloffuse()
+        .args(["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--out"])
+        .arg(dir.path())
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("is a directory"));
+    // A curve that reaches 0 on [0, 1] would make the gain blow up: refused, nothing written.
+    let out = dir.path().join("zero.json");
+    gloffuse()
+        .args(["fit", "-d", "ggx", "-p", "0.5:30", "-p", "1:5", "--weighting", "absolute", "--out"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("must stay above 0"));
+    assert!(!out.exists());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "leftover files");
+}
+
+#[test]
+fn malformed_coefficient_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/presets/blender-4.json")).unwrap();
+    let cases = [
+        ("not json", "not valid JSON".to_string()),
+        ("{\"format\": \"other\"}", "not a coefficients file".to_string()),
+        ("", "not valid JSON".to_string()),
+    ];
+    let mut all: Vec<(String, String)> = cases.iter().map(|(a, b)| (a.to_string(), b.clone())).collect();
+    all.push((good.replace("\"format_version\": 1", "\"format_version\": 7"), "format_version 7 is not supported".into()));
+    all.push((good.replacen("100.0,\n", "100.5,\n", 1), "f(0) must be 100".into()));
+    for (i, (text, fragment)) in all.iter().enumerate() {
+        let path = dir.path().join(format!("c{i}.json"));
+        std::fs::write(&path, text).unwrap();
+        gloffuse()
+            .args(["coefficients", "show"])
+            .arg(&path)
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(fragment.as_str()).and(predicate::str::contains(path.to_str().unwrap())));
+    }
+}
