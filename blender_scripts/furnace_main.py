@@ -74,7 +74,8 @@ def furnace_number(section, key, kind, low, high=None):
                     "%r must be an integer, got %r" % (key, value))
     value = kind(value)
     furnace_require(value >= low and (high is None or value <= high),
-                    "%r = %r is outside [%r, %s]" % (key, value, low, "inf" if high is None else high))
+                    "%r = %r is outside [%r, %s]"
+                    % (key, value, low, "inf" if high is None else high))
     return value
 
 
@@ -112,7 +113,7 @@ def furnace_params(document):
         "cell": furnace_number(section, "cell", int, 4),
         "columns": furnace_number(section, "columns", int, 1),
         "samples": furnace_number(section, "samples", int, 1),
-        "seed": furnace_number(section, "seed", int, 0),
+        "seed": furnace_number(section, "seed", int, 0, 2 ** 31 - 1),  # Cycles' seed range
         "radius_fraction": furnace_number(section, "radius_fraction", float, 0.05, 1.0),
         "threads": furnace_number(section, "threads", int, 0),
         "output": output,

@@ -9,33 +9,32 @@
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
 # Needs GLOFFUSE_PARAMS (header) and the groups library (above) in the same script.
 # ---------------------------------------------------------------------------
-import argparse
-import sys
+import sys  # also imported by groups_lib.py; repeated so this file reads on its own
 
 
-def parse_generate_args(args):
-    parser = argparse.ArgumentParser(
+def parse_generate_args(argv=None):
+    parser = ScriptArgumentParser(  # noqa: F821 -- groups_lib.py
         prog="gloffuse-generate",
         description="Add or update gloffuse's brightness-correction node groups.")
     parser.add_argument("--open", metavar="IN.blend",
                         help="open this .blend file first (default: the file already open)")
     parser.add_argument("--save", metavar="OUT.blend",
                         help="save the result as this .blend file (default: do not save)")
-    return parser.parse_args(args)
+    return parse_script_args(parser, argv)  # noqa: F821 -- groups_lib.py
 
 
 def generate_main():
-    options = parse_generate_args(script_args())
-    params = load_params(GLOFFUSE_PARAMS)
+    options = parse_generate_args()
+    params = load_params(GLOFFUSE_PARAMS)  # noqa: F821 -- header; groups_lib.py
     if options.open:
-        open_blend(options.open)
-    built = build_all(params)
-    saved = save_blend(options.save) if options.save else None
+        open_blend(options.open)  # noqa: F821 -- groups_lib.py
+    built = build_all(params)  # noqa: F821 -- groups_lib.py
+    saved = save_blend(options.save) if options.save else None  # noqa: F821
     names = []
     for _spec, correction, shader in built:
         names.extend([correction.name, shader.name])
-    print(result_line({
-        "blender_version": blender_version_string(),
+    print(result_line({  # noqa: F821 -- groups_lib.py
+        "blender_version": blender_version_string(),  # noqa: F821 -- groups_lib.py
         "groups": names,
         "saved": saved,
     }))
@@ -43,4 +42,4 @@ def generate_main():
 
 
 if __name__ == "__main__":
-    run_main(generate_main)
+    run_main(generate_main)  # noqa: F821 -- groups_lib.py: traceback, exit 1 headless

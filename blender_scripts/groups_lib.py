@@ -13,6 +13,8 @@
 #   build_shader_group(spec, params, correction_tree) -> shader tree
 #   blender_version_string() -> "4.5.15"
 #   script_args(argv=None) -> the arguments meant for the script
+#   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
+#   run_main(main) -> runs main with the error handling described there
 #   result_line(payload) -> "GLOFFUSE_RESULT {...}"
 # ---------------------------------------------------------------------------
 import argparse
@@ -28,8 +30,8 @@ DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
 CURVE_VARIABLES = ("roughness", "alpha")
 
 # Layout of the generated nodes (Blender node-editor units).
-NODE_WIDTH = 150.0
-COLUMN_STEP = 200.0   # NODE_WIDTH plus a 50-unit gap
+NODE_WIDTH = 180.0
+COLUMN_STEP = 230.0   # NODE_WIDTH plus a 50-unit gap
 ROW_STEP = 240.0      # taller than a Math node showing three inputs
 FRAME_INSET = 250.0   # first column inside the frame, clear of the Group Input
 
@@ -37,11 +39,6 @@ FRAME_INSET = 250.0   # first column inside the frame, clear of the Group Input
 # ---------------------------------------------------------------------------
 # Compatibility shim: every difference between Blender versions lives here.
 # ---------------------------------------------------------------------------
-
-def blender_version():
-    """Blender's version as a tuple, e.g. (4, 5, 15)."""
-    return tuple(bpy.app.version)
-
 
 def blender_version_string():
     """Blender's version as "major.minor.patch" (no "LTS" suffix)."""
@@ -89,11 +86,8 @@ def socket_type_of(sock):
     """Base socket type name ('NodeSocketFloat', ...) of an interface socket."""
     if hasattr(sock, "socket_type"):
         return sock.socket_type
-    idname = sock.bl_socket_idname
-    for suffix in _LEGACY_SUBTYPE_SUFFIX.values():
-        if idname.startswith("NodeSocketFloat") and idname.endswith(suffix):
-            return "NodeSocketFloat"
-    return idname
+    idname = sock.bl_socket_idname  # 3.x: 'NodeSocketFloatFactor' and the like
+    return "NodeSocketFloat" if idname.startswith("NodeSocketFloat") else idname
 
 
 def clear_interface(tree):
@@ -155,7 +149,7 @@ def find_socket(sockets, identifier):
 
 
 def multiply_color_node(nodes):
-    """A colour multiply: returns (node, colour_in, factor_in_value_in, out).
+    """A colour multiply with factor 1: returns (node, a_in, b_in, out).
     ShaderNodeMix (3.4+) in RGBA/MULTIPLY mode, sockets found by identifier
     because several share the names A, B and Result; the legacy MixRGB node
     where ShaderNodeMix does not exist."""
@@ -243,8 +237,10 @@ def validate_params(params):
         if curve.get("variable") not in CURVE_VARIABLES:
             raise ValueError("%s.curve.variable is %r; expected 'roughness' or 'alpha'"
                              % (where, curve.get("variable")))
-        _finite_list(curve.get("numerator"), where + ".curve.numerator")
-        _finite_list(curve.get("denominator"), where + ".curve.denominator")
+        for key in ("numerator", "denominator"):
+            coeffs = _finite_list(curve.get(key), "%s.curve.%s" % (where, key))
+            if not any(coeffs):
+                raise ValueError("%s.curve.%s is identically zero" % (where, key))
     return params
 
 
@@ -312,6 +308,19 @@ def short_label(text, limit=63):
     if len(data) <= limit:
         return text
     return data[:limit].decode("utf-8", "ignore")
+
+
+def frame_label(curve):
+    """'Gain = 100 / f(x), f(x) = 38.0 x³ - 79.0 x² + 100.0' when it fits in a
+    label, else 'Gain = 100 / f(x)'."""
+    num = trim_coefficients(curve["numerator"])
+    den = trim_coefficients(curve["denominator"])
+    if len(den) == 1:
+        body = polynomial_text([c / den[0] for c in num])
+    else:
+        body = "(%s) / (%s)" % (polynomial_text(num), polynomial_text(den))
+    text = "Gain = 100 / f(x),  f(x) = " + body
+    return text if len(text.encode("utf-8")) <= 63 else "Gain = 100 / f(x)"
 
 
 def group_description(spec, params, kind):
@@ -509,14 +518,14 @@ def build_correction_group(spec, params):
 
     frame = nodes.new("NodeFrame")
     frame.name = "Gain frame"
-    frame.label = short_label("Gain = 100 / f(x)   (%s)" % spec["distribution"])
+    frame.label = frame_label(curve)
     frame.shrink = True
     frame.location = (0.0, 0.0)
 
     column = 0
     clamp = nodes.new("ShaderNodeClamp")
     clamp.name = "Clamp roughness"
-    clamp.label = "r = clamp(Roughness, 0, 1)"
+    clamp.label = "r = clamp(Roughness)"
     clamp.clamp_type = "MINMAX"
     clamp.inputs["Min"].default_value = 0.0
     clamp.inputs["Max"].default_value = 1.0
@@ -535,7 +544,7 @@ def build_correction_group(spec, params):
         x_socket = square.outputs[0]
         column += 1
     else:
-        clamp.label = "x = clamp(Roughness, 0, 1)"
+        clamp.label = "x = clamp(Roughness)"
 
     num_out, num_const, num_cols = horner_chain(
         tree, curve["numerator"], x_socket, column, 0.0, "num", frame)
@@ -616,8 +625,8 @@ def build_shader_group(spec, params, correction_tree):
     correction.node_tree = correction_tree
     correction.name = "Brightness correction"
     correction.label = short_label(correction_tree.name)
-    correction.width = 180.0
-    correction.location = (COLUMN_STEP + 50.0, 120.0)
+    correction.width = 260.0
+    correction.location = (COLUMN_STEP + 20.0, 160.0)
     links.new(group_in.outputs["Roughness"], correction.inputs["Roughness"])
     links.new(group_in.outputs["Color"], correction.inputs["Color"])
 
@@ -677,6 +686,31 @@ def script_args(argv=None):
     return argv[1:]
 
 
+class ArgumentError(ValueError):
+    """Bad command-line arguments for a gloffuse script."""
+
+
+class ScriptArgumentParser(argparse.ArgumentParser):
+    """argparse that raises ArgumentError instead of exiting, so a mistake
+    never quits an interactive Blender."""
+
+    def error(self, message):
+        raise ArgumentError("%s: %s\n%s" % (self.prog, message, self.format_usage().strip()))
+
+
+def parse_script_args(parser, argv=None):
+    """Parse the script's arguments. Headless: strictly. Interactive (the Text
+    Editor of a Blender that may have been started with other arguments after
+    "--"): unknown arguments are reported and ignored."""
+    args = script_args(argv)
+    if bpy.app.background:
+        return parser.parse_args(args)
+    options, ignored = parser.parse_known_args(args)
+    if ignored:
+        sys.stderr.write("%s: ignoring arguments %s\n" % (parser.prog, " ".join(ignored)))
+    return options
+
+
 def open_blend(path):
     path = os.path.abspath(path)
     if not os.path.isfile(path):
@@ -711,11 +745,18 @@ def result_line(payload):
 
 
 def run_main(main):
-    """Run main(); on error print the traceback and, headless, exit 1 (blender
-    -b --python ignores exceptions unless --python-exit-code is given). In the
-    Text Editor the exception is re-raised so Blender shows it."""
+    """Run main(); on error print the traceback and, headless, exit 1 (2 for
+    bad arguments), because blender -b --python ignores exceptions unless
+    --python-exit-code is given. Interactive (Text Editor) the exception is
+    re-raised so Blender shows it and keeps running."""
     try:
         main()
+    except ArgumentError as error:
+        sys.stderr.write("%s\n" % error)
+        sys.stderr.flush()
+        if bpy.app.background:
+            sys.exit(2)
+        raise
     except Exception:
         traceback.print_exc()
         sys.stderr.flush()

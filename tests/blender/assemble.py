@@ -49,7 +49,7 @@ def sample_params(version="0.1.0"):
             {
                 "distribution": "BECKMANN",
                 "correction_group": "Brightness Correction (Beckmann)",
-                "shader_group": "Gloffuse (Beckmann)",
+                "shader_group": "Gloffuse (Beckmann) \"B\" \\ '\u00e9'",
                 "description": "Seed Beckmann curve '''\"\"\" \\",
                 "curve": {"variable": "roughness",
                           "numerator": [100.0, 0.0, 5.0, -34.0],
@@ -87,6 +87,7 @@ def expectations(params, probes):
         {"correction_group": g["correction_group"],
          "shader_group": g["shader_group"],
          "distribution": g["distribution"],
+         "description": g.get("description", ""),
          "probe": [[r, gain_at(g["curve"], r)] for r in probes]}
         for g in params["groups"]]}
 

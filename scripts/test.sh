@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The whole test suite, against real Blender: installs what is missing, then runs cargo test.
+#   Blender 3.4 — Debian's `blender` package (a real binary)
+#   Blender 4.5 LTS and 5.0 — PyPI's `bpy` (Blender as a Python module, CPython 3.11)
+# Idempotent: a second run reuses what the first installed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cache="${GLOFFUSE_TEST_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/gloffuse/test-blenders}"
+mkdir -p "$cache"
+
+if ! command -v blender >/dev/null 2>&1; then
+    echo "== installing Debian's blender (3.4)"
+    SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq blender >/dev/null
+fi
+
+python="$(command -v python3.11 || command -v python3)"
+provision_bpy() { # name, pip requirement
+    local dir="$cache/$1"
+    if [ ! -x "$dir/bin/python" ] || ! "$dir/bin/python" -c "import bpy" >/dev/null 2>&1; then
+        echo "== installing $2 into $dir"
+        rm -rf "$dir.partial" "$dir"
+        "$python" -m venv "$dir.partial"
+        "$dir.partial/bin/pip" install --quiet --progress-bar off "$2"
+        mv "$dir.partial" "$dir"
+    fi
+}
+provision_bpy bpy-4.5 'bpy>=4.5,<4.6' & bpy45=$!
+provision_bpy bpy-5.0 'bpy>=5.0,<5.1' & bpy50=$!
+wait "$bpy45"; wait "$bpy50"
+
+export GLOFFUSE_TEST_BLENDER_34="$(command -v blender)"
+export GLOFFUSE_TEST_BPY_45="$cache/bpy-4.5/bin/python"
+export GLOFFUSE_TEST_BPY_50="$cache/bpy-5.0/bin/python"
+"$GLOFFUSE_TEST_BLENDER_34" -b --factory-startup -noaudio --version 2>/dev/null | head -1
+"$GLOFFUSE_TEST_BPY_45" -c "import bpy; print('bpy', bpy.app.version_string)"
+"$GLOFFUSE_TEST_BPY_50" -c "import bpy; print('bpy', bpy.app.version_string)"
+
+cargo test --locked "$@"
