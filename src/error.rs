@@ -32,6 +32,33 @@ pub enum Error {
 
     #[error("cannot write {}: {message}", path.display())]
     Write { path: PathBuf, message: String },
+
+    /// A Blender (or bpy) was found but could not be used, or a run in it failed. `log` is
+    /// the file that holds its output; `command` the shell-quoted command to rerun it.
+    #[error("{}", blender_display(message, log.as_deref(), command.as_deref()))]
+    Blender {
+        message: String,
+        log: Option<PathBuf>,
+        command: Option<String>,
+    },
+
+    /// No usable Blender: the message says where gloffuse looked and how to point at one.
+    #[error("{0}")]
+    BlenderNotFound(String),
+}
+
+/// A one-line message gets `; log: …; command: …` appended; a multi-line one (quoted
+/// output) gets them on lines of their own, so the path and command are easy to copy.
+fn blender_display(message: &str, log: Option<&std::path::Path>, command: Option<&str>) -> String {
+    let sep = if message.contains('\n') { "\n  " } else { "; " };
+    let mut s = message.trim_end().to_string();
+    if let Some(log) = log {
+        s.push_str(&format!("{sep}log: {}", log.display()));
+    }
+    if let Some(command) = command {
+        s.push_str(&format!("{sep}command: {command}"));
+    }
+    s
 }
 
 impl Error {

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod coefficients;
 pub mod error;
 pub mod fit;
+pub mod furnace;
 pub mod microfacet;
 pub mod output;
 

@@ -1,0 +1,379 @@
+//! Running a Python script in headless Blender (or in a Python that imports bpy): its own
+//! process group, its output in a log file, a timeout that kills the whole group, and the
+//! result read back from one marked line of its output.
+//!
+//! The script reports by printing one line `GLOFFUSE_RESULT {json}` to stdout; the last such
+//! line wins. Write it in one call and flush, so Blender's own output cannot split it:
+//! `sys.stdout.write("GLOFFUSE_RESULT " + json.dumps(result) + "\n"); sys.stdout.flush()`.
+
+use std::ffi::{OsStr, OsString};
+use std::fs::File;
+use std::io;
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+use super::discover::{Blender, BlenderKind};
+use crate::Error;
+
+/// The prefix of the stdout line that carries a script's result as JSON.
+pub const RESULT_PREFIX: &str = "GLOFFUSE_RESULT ";
+
+/// The line Python prints at the start of an uncaught exception's traceback.
+const TRACEBACK: &str = "Traceback (most recent call last)";
+
+/// How many lines of a traceback, or of the end of the log, an error quotes.
+const TRACEBACK_LINES: usize = 8;
+const TAIL_LINES: usize = 15;
+
+/// One run of `script` in `blender`.
+#[derive(Clone, Debug)]
+pub struct Run<'a> {
+    pub blender: &'a Blender,
+    pub script: &'a Path,
+    /// The script's own arguments (after `--` for a `blender` binary; `sys.argv[1:]` for bpy).
+    pub args: Vec<OsString>,
+    pub timeout: Duration,
+    /// Where stdout and stderr go (created or truncated); it exists afterwards, whatever
+    /// happened.
+    pub log: PathBuf,
+}
+
+/// What a successful run gave back.
+#[derive(Clone, Debug)]
+pub struct RunOutput {
+    /// Parsed from the last stdout line starting with [`RESULT_PREFIX`].
+    pub result: serde_json::Value,
+    pub log: PathBuf,
+    /// Wall-clock time of the run.
+    pub seconds: f64,
+}
+
+/// The full argument vector, program first.
+///
+/// Binary: `blender -b --factory-startup -noaudio --python-exit-code 1 --python SCRIPT -- ARGS`;
+/// bpy module: `PYTHON SCRIPT ARGS`.
+pub fn argv(run: &Run) -> Vec<OsString> {
+    let mut v: Vec<OsString> = vec![run.blender.program.clone().into_os_string()];
+    match run.blender.kind {
+        BlenderKind::Binary => {
+            for a in [
+                "-b",
+                "--factory-startup",
+                "-noaudio",
+                "--python-exit-code",
+                "1",
+                "--python",
+            ] {
+                v.push(a.into());
+            }
+            v.push(run.script.as_os_str().to_owned());
+            v.push("--".into());
+        }
+        BlenderKind::PythonModule => v.push(run.script.as_os_str().to_owned()),
+    }
+    v.extend(run.args.iter().cloned());
+    v
+}
+
+/// The command, shell-quoted so that a person can paste it to rerun the run.
+pub fn command_line(run: &Run) -> String {
+    shell_join(&argv(run))
+}
+
+/// Runs the script, waits at most `run.timeout`, and reads its result back.
+///
+/// Errors ([`Error::Blender`], naming the log and the command): Blender cannot be started,
+/// it times out (its whole process group is killed), it exits non-zero, its log holds a
+/// Python traceback, or it prints no parseable `GLOFFUSE_RESULT` line.
+pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
+    let argv = argv(run);
+    let command = shell_join(&argv);
+    let fail = |message: String| Error::Blender {
+        message,
+        log: Some(run.log.clone()),
+        command: Some(command.clone()),
+    };
+    let log = File::create(&run.log).map_err(|e| Error::Write {
+        path: run.log.clone(),
+        message: e.to_string(),
+    })?;
+    let start = Instant::now();
+    let exit = run_logged(&argv, &log, run.timeout).map_err(|e| {
+        fail(format!(
+            "cannot start {}: {e}",
+            run.blender.program.display()
+        ))
+    })?;
+    let seconds = start.elapsed().as_secs_f64();
+    drop(log);
+    let status = match exit {
+        Exit::TimedOut => {
+            return Err(fail(format!(
+                "Blender timed out after {} s (--timeout)",
+                format_seconds(run.timeout)
+            )));
+        }
+        Exit::Finished(status) => status,
+    };
+    let bytes = std::fs::read(&run.log).map_err(|e| Error::Read {
+        path: run.log.clone(),
+        source: e,
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let result = check_output(&text, status).map_err(fail)?;
+    Ok(RunOutput {
+        result,
+        log: run.log.clone(),
+        seconds,
+    })
+}
+
+/// How a child ended.
+#[derive(Debug)]
+pub(crate) enum Exit {
+    Finished(ExitStatus),
+    /// The timeout passed; the child's process group was killed and the child reaped.
+    TimedOut,
+}
+
+/// Runs `argv` in a process group of its own, stdin from /dev/null, stdout and stderr both
+/// to `out`, and waits at most `timeout`. On timeout the whole group is killed (SIGKILL)
+/// and the child reaped, so neither it nor its children outlive the call.
+pub(crate) fn run_logged(argv: &[OsString], out: &File, timeout: Duration) -> io::Result<Exit> {
+    let (program, args) = argv
+        .split_first()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "empty command"))?;
+    let mut cmd = Command::new(program);
+    cmd.args(args)
+        .stdin(Stdio::null())
+        .stdout(out.try_clone()?)
+        .stderr(out.try_clone()?)
+        // Unbuffered Python: the log is in order and nothing is lost if Blender crashes.
+        .env("PYTHONUNBUFFERED", "1")
+        .process_group(0);
+    die_with_parent(&mut cmd);
+    let mut child = cmd.spawn()?;
+    let start = Instant::now();
+    let mut pause = Duration::from_millis(2);
+    loop {
+        if let Some(status) = child.try_wait()? {
+            return Ok(Exit::Finished(status));
+        }
+        let elapsed = start.elapsed();
+        if elapsed >= timeout {
+            // The group id is the child's pid (process_group(0)); the child is not yet
+            // reaped, so the id cannot have been reused.
+            let killed = match libc::pid_t::try_from(child.id()) {
+                // SAFETY: killpg only sends a signal; it touches no memory of ours.
+                Ok(pgid) => (unsafe { libc::killpg(pgid, libc::SIGKILL) }) == 0,
+                Err(_) => false,
+            };
+            if !killed {
+                let _ = child.kill();
+            }
+            child.wait()?;
+            return Ok(Exit::TimedOut);
+        }
+        std::thread::sleep(pause.min(timeout - elapsed));
+        pause = (pause * 2).min(Duration::from_millis(50));
+    }
+}
+
+/// Asks Linux to kill the child when gloffuse dies (a child in its own process group does
+/// not get the terminal's Ctrl-C), so an interrupted gloffuse leaves no Blender behind.
+#[cfg(target_os = "linux")]
+fn die_with_parent(cmd: &mut Command) {
+    let parent = std::process::id();
+    // SAFETY: the closure runs between fork and exec and calls only async-signal-safe
+    // functions (prctl, getppid); it allocates nothing.
+    unsafe {
+        cmd.pre_exec(move || {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) == -1 {
+                return Err(io::Error::last_os_error());
+            }
+            // The parent may have died before prctl took effect.
+            if u32::try_from(libc::getppid()).ok() != Some(parent) {
+                return Err(io::Error::from_raw_os_error(libc::ESRCH));
+            }
+            Ok(())
+        });
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn die_with_parent(_cmd: &mut Command) {}
+
+/// Decides whether a finished run succeeded, from its exit status and its log; on failure
+/// the message quotes the lines that say why.
+fn check_output(text: &str, status: ExitStatus) -> Result<serde_json::Value, String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let traceback = last_traceback(&lines);
+    let quote = |what: &[&str]| -> String {
+        what.iter()
+            .map(|l| format!("\n    {}", clip(l, 300)))
+            .collect()
+    };
+    if !status.success() {
+        let why = describe_status(status);
+        return Err(match traceback {
+            Some(tb) => format!("Blender {why}; its Python script raised:{}", quote(tb)),
+            None => format!("Blender {why}; the log ends:{}", quote(tail(&lines))),
+        });
+    }
+    if let Some(tb) = traceback {
+        return Err(format!(
+            "Blender exited 0 but its log holds a Python traceback:{}",
+            quote(tb)
+        ));
+    }
+    let Some(line) = lines
+        .iter()
+        .rev()
+        .find_map(|l| l.trim_end().strip_prefix(RESULT_PREFIX))
+    else {
+        return Err(format!(
+            "Blender exited 0 but printed no result line ({}{{…}}); the log ends:{}",
+            RESULT_PREFIX,
+            quote(tail(&lines))
+        ));
+    };
+    serde_json::from_str(line).map_err(|e| {
+        format!(
+            "Blender's result line is not valid JSON ({e}):{}",
+            quote(&[line])
+        )
+    })
+}
+
+/// The last traceback in the log, from its `Traceback` line to the exception line (the
+/// first unindented line after it), cut to its last [`TRACEBACK_LINES`] lines.
+fn last_traceback<'t>(lines: &'t [&'t str]) -> Option<&'t [&'t str]> {
+    let start = lines.iter().rposition(|l| l.contains(TRACEBACK))?;
+    let end = lines[start + 1..]
+        .iter()
+        .position(|l| !l.is_empty() && !l.starts_with([' ', '\t']))
+        .map_or(lines.len(), |i| start + 1 + i + 1);
+    let block = &lines[start..end];
+    Some(&block[block.len().saturating_sub(TRACEBACK_LINES)..])
+}
+
+/// The last [`TAIL_LINES`] non-blank lines.
+fn tail<'t>(lines: &'t [&'t str]) -> &'t [&'t str] {
+    let end = lines
+        .iter()
+        .rposition(|l| !l.trim().is_empty())
+        .map_or(0, |i| i + 1);
+    if end == 0 {
+        return &["(the log is empty)"];
+    }
+    &lines[end.saturating_sub(TAIL_LINES)..end]
+}
+
+fn clip(line: &str, max: usize) -> String {
+    match line.char_indices().nth(max) {
+        Some((i, _)) => format!("{}…", &line[..i]),
+        None => line.to_string(),
+    }
+}
+
+fn describe_status(status: ExitStatus) -> String {
+    match (status.code(), status.signal()) {
+        (Some(code), _) => format!("exited with status {code}"),
+        (None, Some(sig)) => format!("was killed by signal {sig}"),
+        (None, None) => format!("ended abnormally ({status})"),
+    }
+}
+
+/// `2`, `0.5`, `90` — seconds as a person writes them on the command line.
+pub(crate) fn format_seconds(d: Duration) -> String {
+    if d.subsec_nanos() == 0 {
+        d.as_secs().to_string()
+    } else {
+        format!("{}", (d.as_secs_f64() * 1000.0).round() / 1000.0)
+    }
+}
+
+/// Joins arguments into one POSIX-shell command line (arguments with anything beyond
+/// `[A-Za-z0-9_@%+=:,./-]` are single-quoted; bad UTF-8 is shown lossily).
+pub fn shell_join(argv: &[OsString]) -> String {
+    argv.iter()
+        .map(|a| shell_quote(a))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Quotes one argument for a POSIX shell.
+///
+/// ```
+/// use gloffuse::blender::run::shell_quote;
+/// assert_eq!(shell_quote("/usr/bin/blender".as_ref()), "/usr/bin/blender");
+/// assert_eq!(shell_quote("it's here".as_ref()), r"'it'\''s here'");
+/// assert_eq!(shell_quote("".as_ref()), "''");
+/// ```
+pub fn shell_quote(arg: &OsStr) -> String {
+    let s = arg.to_string_lossy();
+    let safe = |c: char| c.is_ascii_alphanumeric() || "_@%+=:,./-".contains(c);
+    if !s.is_empty() && s.chars().all(safe) {
+        s.into_owned()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ok() -> ExitStatus {
+        ExitStatus::from_raw(0)
+    }
+
+    #[test]
+    fn result_is_the_last_marked_line() {
+        let log = "Blender 4.5\nGLOFFUSE_RESULT {\"a\": 1}\nnoise\nGLOFFUSE_RESULT {\"a\": 2}\n\nBlender quit\n";
+        assert_eq!(check_output(log, ok()).unwrap()["a"], 2);
+    }
+
+    #[test]
+    fn failures_quote_the_right_lines() {
+        let log = "start\nTraceback (most recent call last):\n  File \"x.py\", line 3, in <module>\n    1/0\nZeroDivisionError: division by zero\nBlender quit\n";
+        let e = check_output(log, ExitStatus::from_raw(1 << 8)).unwrap_err();
+        assert!(e.contains("exited with status 1"), "{e}");
+        assert!(e.contains("ZeroDivisionError"), "{e}");
+        assert!(!e.contains("Blender quit"), "{e}");
+        // A traceback fails the run even with exit status 0.
+        let with_result = format!("{log}GLOFFUSE_RESULT {{}}\n");
+        assert!(
+            check_output(&with_result, ok())
+                .unwrap_err()
+                .contains("traceback")
+        );
+        let e = check_output("a\nb\n", ok()).unwrap_err();
+        assert!(e.contains("no result line") && e.contains("\n    b"), "{e}");
+        let e = check_output("GLOFFUSE_RESULT {oops\n", ok()).unwrap_err();
+        assert!(e.contains("not valid JSON"), "{e}");
+        assert!(check_output("", ok()).unwrap_err().contains("log is empty"));
+    }
+
+    #[test]
+    fn long_tracebacks_are_cut_to_their_end() {
+        let mut log = String::from("Traceback (most recent call last):\n");
+        for i in 0..20 {
+            log.push_str(&format!("  File \"f{i}.py\", line {i}\n"));
+        }
+        log.push_str("KeyError: 'x'\nafter\n");
+        let e = check_output(&log, ok()).unwrap_err();
+        assert_eq!(e.matches("\n    ").count(), TRACEBACK_LINES);
+        assert!(e.contains("KeyError") && !e.contains("f0.py") && !e.contains("after"));
+    }
+
+    #[test]
+    fn seconds_and_quoting() {
+        assert_eq!(format_seconds(Duration::from_secs(2)), "2");
+        assert_eq!(format_seconds(Duration::from_millis(1500)), "1.5");
+        let argv: Vec<OsString> = vec!["blender".into(), "--".into(), "a b".into(), "$x".into()];
+        assert_eq!(shell_join(&argv), "blender -- 'a b' '$x'");
+    }
+}

@@ -1,0 +1,5 @@
+//! Furnace verification: render plans, EXR read-back, sphere statistics.
+
+pub mod image;
+pub mod plan;
+pub mod stats;

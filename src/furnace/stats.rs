@@ -1,0 +1,96 @@
+//! Statistics of one furnace sphere in its grid cell.
+//!
+//! An orthographic view of a sphere of radius R pixels sees, at distance d from the centre,
+//! the view cosine μ = √(1 − (d/R)²); the cosines of the disc have density 2μ, so the
+//! coverage-weighted mean Σ RGB / Σ alpha is the sphere's E_avg.
+
+use serde::Serialize;
+
+use super::image::Rgba;
+
+/// Number of view-cosine rings in a profile.
+pub const RINGS: usize = 10;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Ring {
+    /// Lower and upper view cosine of the ring.
+    pub mu: (f64, f64),
+    pub pixels: usize,
+    /// Mean brightness (0–1) of the ring's fully covered pixels; NaN if it holds none.
+    pub mean: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SphereStats {
+    /// Σ RGB / (3 Σ alpha) over the cell: the sphere's mean brightness (0–1).
+    pub mean: f64,
+    /// Estimated standard error of `mean` (from the pixel spread within each ring).
+    pub standard_error: f64,
+    /// Mean of the pixels with μ ≥ 0.995 (within 10 % of the radius of the centre).
+    pub center: f64,
+    pub coverage: f64,
+    pub rings: Vec<Ring>,
+}
+
+/// Statistics of cell `index` in a grid of `columns` cells of `cell` pixels, where the
+/// sphere's diameter is `radius_fraction` of the cell.
+pub fn sphere_stats(img: &Rgba, index: usize, columns: usize, cell: usize, radius_fraction: f64) -> SphereStats {
+    let (col, row) = (index % columns, index / columns);
+    let (x0, y0) = (col * cell, row * cell);
+    let centre = cell as f64 / 2.0;
+    let radius = radius_fraction * cell as f64 / 2.0;
+    let (mut sum_rgb, mut sum_a) = (0.0f64, 0.0f64);
+    let (mut centre_sum, mut centre_n) = (0.0f64, 0usize);
+    let mut ring_sum = [0.0f64; RINGS];
+    let mut ring_sq = [0.0f64; RINGS];
+    let mut ring_n = [0usize; RINGS];
+    for y in y0..(y0 + cell).min(img.height) {
+        for x in x0..(x0 + cell).min(img.width) {
+            let p = img.pixels[y * img.width + x];
+            let rgb = (p[0] as f64 + p[1] as f64 + p[2] as f64) / 3.0;
+            sum_rgb += rgb;
+            sum_a += p[3] as f64;
+            let dx = (x - x0) as f64 + 0.5 - centre;
+            let dy = (y - y0) as f64 + 0.5 - centre;
+            let d = (dx * dx + dy * dy).sqrt() / radius;
+            // Only pixels whose filter footprint lies inside the disc count as fully covered.
+            if d * radius < radius - 2.0 && p[3] > 0.999 {
+                let v = rgb / p[3] as f64;
+                let mu = (1.0 - d * d).sqrt();
+                let k = ((mu * RINGS as f64) as usize).min(RINGS - 1);
+                ring_sum[k] += v;
+                ring_sq[k] += v * v;
+                ring_n[k] += 1;
+                if d <= 0.1 {
+                    centre_sum += v;
+                    centre_n += 1;
+                }
+            }
+        }
+    }
+    let mean = if sum_a > 0.0 { sum_rgb / sum_a } else { f64::NAN };
+    // Pixel noise is independent between pixels; within a ring all pixels share (nearly)
+    // one expected value, so the ring's sample variance estimates each pixel's variance.
+    let mut var_sum = 0.0;
+    let mut n_total = 0usize;
+    let rings = (0..RINGS)
+        .map(|k| {
+            let n = ring_n[k];
+            let m = if n > 0 { ring_sum[k] / n as f64 } else { f64::NAN };
+            if n > 1 {
+                let var = (ring_sq[k] - n as f64 * m * m) / (n as f64 - 1.0);
+                var_sum += var.max(0.0) * n as f64;
+            }
+            n_total += n;
+            Ring { mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64), pixels: n, mean: m }
+        })
+        .collect();
+    let standard_error = if n_total > 0 { var_sum.sqrt() / n_total as f64 } else { f64::NAN };
+    SphereStats {
+        mean,
+        standard_error,
+        center: if centre_n > 0 { centre_sum / centre_n as f64 } else { f64::NAN },
+        coverage: sum_a / (cell * cell) as f64,
+        rings,
+    }
+}
