@@ -5,7 +5,9 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness};
+use gloffuse::microfacet::{
+    AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness,
+};
 use rayon::prelude::*;
 
 fn main() {
@@ -25,15 +27,33 @@ fn main() {
         .par_iter()
         .map(|(g, mu)| common::brute_force_albedo(g, *mu, 3000, 3000))
         .collect();
-    for (theta, phi) in [(12, 6), (16, 8), (20, 8), (24, 8), (24, 12), (32, 8), (32, 16), (48, 16)] {
+    for (theta, phi) in [
+        (12, 6),
+        (16, 8),
+        (20, 8),
+        (24, 8),
+        (24, 12),
+        (32, 8),
+        (32, 16),
+        (48, 16),
+    ] {
         let q = AlbedoIntegrator::new(Quadrature { theta, phi, mu: 24 });
         let mut worst = (0.0, String::new());
         for ((g, mu), r) in cases.iter().zip(&reference) {
             let e = (q.directional_albedo(g, *mu) - r).abs();
             if e > worst.0 {
-                worst = (e, format!("{} {} alpha={:.4} mu={mu}", g.distribution, g.masking, g.alpha));
+                worst = (
+                    e,
+                    format!(
+                        "{} {} alpha={:.4} mu={mu}",
+                        g.distribution, g.masking, g.alpha
+                    ),
+                );
             }
         }
-        println!("theta={theta:3} phi={phi:3}: max |error| = {:.2e} at {}", worst.0, worst.1);
+        println!(
+            "theta={theta:3} phi={phi:3}: max |error| = {:.2e} at {}",
+            worst.0, worst.1
+        );
     }
 }

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use crate::Error;
 use crate::cli::{AlbedoArgs, Cli, CoefficientsCommand, Command, FitArgs};
 use crate::coefficients::{
-    self, ColorSpace, Coefficients, Entry, FORMAT, FORMAT_VERSION, PRESETS, Provenance, Target,
+    self, Coefficients, ColorSpace, Entry, FORMAT, FORMAT_VERSION, PRESETS, Provenance, Target,
 };
 use crate::fit::{Curve, Fit, Variable, fit_polynomial};
 use crate::microfacet::{AlbedoIntegrator, Glossy};
@@ -21,6 +21,29 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
     match cli.command {
         Command::Albedo(a) => albedo(a),
         Command::Fit(f) => fit(f),
+        Command::Generate(g) => {
+            let out = crate::generate::generate(&g)?;
+            if g.json {
+                println!("{}", serde_json::to_string_pretty(&out).expect("json"));
+            } else {
+                if let Some(p) = &out.script {
+                    println!("script: {}", p.display());
+                }
+                if let Some(p) = &out.blend {
+                    println!(
+                        "blend:  {} (Blender {})",
+                        p.display(),
+                        out.blender.as_deref().unwrap_or("?")
+                    );
+                }
+                if let Some(p) = &out.backup {
+                    println!("backup: {}", p.display());
+                }
+                println!("coefficients: {}", out.coefficients);
+                println!("groups: {}", out.groups.join(", "));
+            }
+            Ok(0)
+        }
         Command::Coefficients {
             action: CoefficientsCommand::Show { source, json },
         } => show(source, json),
@@ -57,7 +80,11 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
         return Ok(0);
     }
     let roughness = a.roughness.ok_or_else(|| {
-        Error::input("arguments", "(none)", "--roughness R (0 to 1), or --table FILE for a grid")
+        Error::input(
+            "arguments",
+            "(none)",
+            "--roughness R (0 to 1), or --table FILE for a grid",
+        )
     })?;
     let g = Glossy::new(a.distribution, masking, roughness);
     let e = integrator.directional_albedo(&g, a.mu);
@@ -83,8 +110,16 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
             a.blender_version,
             masking
         );
-        println!("E(mu = {}) = {e:.6}   brightness at view cosine {} ({:.2} %)", a.mu, a.mu, 100.0 * e);
-        println!("E_avg      = {avg:.6}   mean brightness of a furnace sphere ({:.2} %)", 100.0 * avg);
+        println!(
+            "E(mu = {}) = {e:.6}   brightness at view cosine {} ({:.2} %)",
+            a.mu,
+            a.mu,
+            100.0 * e
+        );
+        println!(
+            "E_avg      = {avg:.6}   mean brightness of a furnace sphere ({:.2} %)",
+            100.0 * avg
+        );
     }
     Ok(0)
 }
@@ -99,10 +134,20 @@ fn fit(f: FitArgs) -> Result<i32, Error> {
             ));
         }
         let degree = f.degree.unwrap_or(INTEGRATOR_DEGREE);
-        Coefficients::from_integrator(f.blender_version, degree, f.target, f.weighting, Some(coefficients::today()))?
+        Coefficients::from_integrator(
+            f.blender_version,
+            degree,
+            f.target,
+            f.weighting,
+            Some(coefficients::today()),
+        )?
     } else {
         let d = f.distribution.ok_or_else(|| {
-            Error::input("arguments", "(no --distribution)", "--distribution D with --point R:PERCENT values, or --from integrator")
+            Error::input(
+                "arguments",
+                "(no --distribution)",
+                "--distribution D with --point R:PERCENT values, or --from integrator",
+            )
         })?;
         if f.points.is_empty() {
             return Err(Error::input(
@@ -112,7 +157,8 @@ fn fit(f: FitArgs) -> Result<i32, Error> {
             ));
         }
         let degree = f.degree.unwrap_or(3);
-        let Fit { curve, residuals } = fit_polynomial(&f.points, Variable::Roughness, degree, f.weighting)?;
+        let Fit { curve, residuals } =
+            fit_polynomial(&f.points, Variable::Roughness, degree, f.weighting)?;
         let entry = Entry {
             degree,
             curve,
@@ -129,7 +175,11 @@ fn fit(f: FitArgs) -> Result<i32, Error> {
                 points: f.points.len(),
                 date: Some(coefficients::today()),
                 note: Some(
-                    f.points.iter().map(|p| format!("{}:{}", p.roughness, p.percent)).collect::<Vec<_>>().join(" "),
+                    f.points
+                        .iter()
+                        .map(|p| format!("{}:{}", p.roughness, p.percent))
+                        .collect::<Vec<_>>()
+                        .join(" "),
                 ),
             },
         };
@@ -166,7 +216,10 @@ fn fit(f: FitArgs) -> Result<i32, Error> {
                 })
             })
             .collect();
-        println!("{}", serde_json::to_string_pretty(&json!({ "fits": list })).expect("json"));
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({ "fits": list })).expect("json")
+        );
     } else {
         for (d, e) in &coefficients.distributions {
             print!("{}", describe_entry(d.label(), e));
@@ -188,7 +241,7 @@ pub fn formula(curve: &Curve) -> String {
                 continue;
             }
             let t = match k {
-                0 => format!("{}", fmt_num(v.abs())),
+                0 => fmt_num(v.abs()),
                 1 => format!("{} {var}", fmt_num(v.abs())),
                 _ => format!("{} {var}^{k}", fmt_num(v.abs())),
             };
@@ -211,7 +264,11 @@ pub fn formula(curve: &Curve) -> String {
     if curve.denominator == [1.0] {
         poly(&curve.numerator)
     } else {
-        format!("({}) / ({})", poly(&curve.numerator), poly(&curve.denominator))
+        format!(
+            "({}) / ({})",
+            poly(&curve.numerator),
+            poly(&curve.denominator)
+        )
     }
 }
 
@@ -227,7 +284,13 @@ fn describe_entry(label: &str, e: &Entry) -> String {
     if e.curve.variable == Variable::Roughness && e.curve.denominator == [1.0] {
         let n = &e.curve.numerator;
         let c = |k: usize| n.get(k).copied().unwrap_or(0.0);
-        let mut line = format!("  a = {}, b = {}, c = {}, d = {}", fmt_num_signed(c(3)), fmt_num_signed(c(2)), fmt_num_signed(c(1)), fmt_num_signed(c(0)));
+        let mut line = format!(
+            "  a = {}, b = {}, c = {}, d = {}",
+            fmt_num_signed(c(3)),
+            fmt_num_signed(c(2)),
+            fmt_num_signed(c(1)),
+            fmt_num_signed(c(0))
+        );
         for k in 4..n.len() {
             let _ = write!(line, ", r^{k}: {}", fmt_num_signed(c(k)));
         }
@@ -288,7 +351,11 @@ fn describe_entry(label: &str, e: &Entry) -> String {
 }
 
 fn fmt_num_signed(v: f64) -> String {
-    if v < 0.0 { format!("-{}", fmt_num(-v)) } else { fmt_num(v) }
+    if v < 0.0 {
+        format!("-{}", fmt_num(-v))
+    } else {
+        fmt_num(v)
+    }
 }
 
 fn show(source: Option<String>, json: bool) -> Result<i32, Error> {

@@ -39,6 +39,13 @@ pub enum Command {
     /// distributions from the integrator (--from integrator) into a coefficients file. The
     /// shader gain that restores 100 % is 100/f(r).
     Fit(FitArgs),
+    /// Write the brightness-correction node groups: a Python script, a new .blend, or into a .blend.
+    ///
+    /// Builds `Brightness Correction (…)` (gain = 100/f(r)) and `Gloffuse (…)` (a Glossy BSDF
+    /// driven by the corrected colour) for each distribution in the coefficients. --script
+    /// needs no Blender; --blend and --into run Blender headless (found or installed
+    /// automatically, see --blender).
+    Generate(GenerateArgs),
     /// Inspect coefficient files and the built-in presets.
     Coefficients {
         #[command(subcommand)]
@@ -123,6 +130,57 @@ pub struct FitArgs {
     pub json: bool,
 }
 
+/// Where Blender comes from and how long it may run: shared by every command that runs it.
+#[derive(Args, Debug, Clone)]
+pub struct BlenderArgs {
+    /// A Blender executable, or a Python interpreter that imports bpy. Otherwise gloffuse
+    /// tries $GLOFFUSE_BLENDER, `blender` on PATH, then a bpy it installed earlier, and
+    /// finally installs bpy 4.5 LTS into its cache directory.
+    #[arg(long, value_name = "PATH")]
+    pub blender: Option<PathBuf>,
+
+    /// Never install bpy; fail with advice instead when no Blender is found.
+    #[arg(long)]
+    pub no_provision: bool,
+
+    /// Kill Blender (and its children) after this many seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 600, value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    pub timeout: u64,
+}
+
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    /// A preset (seed, blender-3, blender-4) or a coefficients file [default: the preset of
+    /// the Blender used: blender-3 for 3.0–3.5, blender-4 for 3.6 and later].
+    #[arg(long, value_name = "PRESET|FILE")]
+    pub coefficients: Option<String>,
+
+    /// Write the generated Python script here (no Blender needed). Run it in Blender's
+    /// Text Editor, or `blender -b --python FILE -- --save OUT.blend`.
+    #[arg(long, value_name = "OUT.py")]
+    pub script: Option<PathBuf>,
+
+    /// Write a new .blend library holding the groups (marked as assets).
+    #[arg(long, value_name = "OUT.blend", conflicts_with = "into")]
+    pub blend: Option<PathBuf>,
+
+    /// Add or replace the groups in an existing .blend, in place (materials using them keep
+    /// working); the previous file is kept as FILE.blend1.
+    #[arg(long, value_name = "EXISTING.blend")]
+    pub into: Option<PathBuf>,
+
+    /// With only --script: the Blender version whose preset to use by default.
+    #[arg(long, default_value = "4.5", value_parser = parse_version)]
+    pub blender_version: BlenderVersion,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+
+    /// Print a JSON summary instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
 #[derive(Subcommand, Debug)]
 pub enum CoefficientsCommand {
     /// Print a readable summary of a preset or coefficients file (no argument: list presets).
@@ -155,6 +213,8 @@ fn parse_point(s: &str) -> Result<Point, String> {
 fn parse_mu(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 && v <= 1.0 => Ok(v),
-        _ => Err(format!("invalid view cosine '{s}': expected a number in (0, 1], e.g. 1 or 0.5")),
+        _ => Err(format!(
+            "invalid view cosine '{s}': expected a number in (0, 1], e.g. 1 or 0.5"
+        )),
     }
 }

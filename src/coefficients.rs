@@ -107,10 +107,7 @@ impl Coefficients {
             let names: Vec<&str> = PRESETS.iter().map(|p| p.0).collect();
             return Err(Error::Coefficients {
                 source_name: preset_or_path.to_string(),
-                message: format!(
-                    "no such preset or file (presets: {})",
-                    names.join(", ")
-                ),
+                message: format!("no such preset or file (presets: {})", names.join(", ")),
             });
         }
         let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
@@ -130,7 +127,11 @@ impl Coefficients {
             serde_json::from_str(text).map_err(|e| fail(format!("not valid JSON: {e}")))?;
         match value.get("format").and_then(|f| f.as_str()) {
             Some(FORMAT) => {}
-            _ => return Err(fail(format!("not a coefficients file (\"format\" must be \"{FORMAT}\")"))),
+            _ => {
+                return Err(fail(format!(
+                    "not a coefficients file (\"format\" must be \"{FORMAT}\")"
+                )));
+            }
         }
         match value.get("format_version").and_then(|v| v.as_u64()) {
             Some(v) if v == FORMAT_VERSION as u64 => {}
@@ -159,10 +160,15 @@ impl Coefficients {
                 return Err(format!("{d}: coefficient {bad} is not a finite number"));
             }
             if c.numerator.is_empty() || c.denominator.is_empty() {
-                return Err(format!("{d}: numerator and denominator need at least one coefficient"));
+                return Err(format!(
+                    "{d}: numerator and denominator need at least one coefficient"
+                ));
             }
             if c.degree_in_r() > MAX_DEGREE {
-                return Err(format!("{d}: degree {} is above the maximum {MAX_DEGREE}", c.degree_in_r()));
+                return Err(format!(
+                    "{d}: degree {} is above the maximum {MAX_DEGREE}",
+                    c.degree_in_r()
+                ));
             }
             if c.denominator[0] != 1.0 || c.numerator[0] != 100.0 {
                 return Err(format!(
@@ -179,7 +185,7 @@ impl Coefficients {
             for i in 0..=1000 {
                 let r = i as f64 / 1000.0;
                 let f = c.percent(r);
-                if !(f > 0.0) || !f.is_finite() {
+                if f.is_nan() || f <= 0.0 || !f.is_finite() {
                     return Err(format!(
                         "{d}: f({r}) = {f}: the curve must stay above 0 on roughness [0, 1] (the gain 100/f would blow up)"
                     ));
@@ -218,7 +224,10 @@ impl Coefficients {
             let points: Vec<Point> = rs
                 .iter()
                 .zip(&values)
-                .map(|(&roughness, &e)| Point { roughness, percent: 100.0 * e })
+                .map(|(&roughness, &e)| Point {
+                    roughness,
+                    percent: 100.0 * e,
+                })
                 .collect();
             let fit = fit_polynomial(&points, Variable::Roughness, degree, weighting)?;
             distributions.insert(

@@ -79,7 +79,11 @@ impl Curve {
 
     /// Polynomial degree in r (alpha-curves count double).
     pub fn degree_in_r(&self) -> usize {
-        let d = self.numerator.len().max(self.denominator.len()).saturating_sub(1);
+        let d = self
+            .numerator
+            .len()
+            .max(self.denominator.len())
+            .saturating_sub(1);
         match self.variable {
             Variable::Roughness => d,
             Variable::Alpha => 2 * d,
@@ -113,12 +117,20 @@ impl std::str::FromStr for Point {
             Error::input(
                 "point",
                 s,
-                &format!("ROUGHNESS:PERCENT with roughness in [0, 1] and a brightness above 0, e.g. 0.5:97 ({why})"),
+                &format!(
+                    "ROUGHNESS:PERCENT with roughness in [0, 1] and a brightness above 0, e.g. 0.5:97 ({why})"
+                ),
             )
         };
         let (r, p) = s.split_once(':').ok_or_else(|| bad("no ':'"))?;
-        let roughness: f64 = r.trim().parse().map_err(|_| bad("roughness is not a number"))?;
-        let percent: f64 = p.trim().parse().map_err(|_| bad("percent is not a number"))?;
+        let roughness: f64 = r
+            .trim()
+            .parse()
+            .map_err(|_| bad("roughness is not a number"))?;
+        let percent: f64 = p
+            .trim()
+            .parse()
+            .map_err(|_| bad("percent is not a number"))?;
         if !roughness.is_finite() || !(0.0..=1.0).contains(&roughness) {
             return Err(bad("roughness outside [0, 1]"));
         }
@@ -199,7 +211,10 @@ pub fn fit_polynomial(
             points.len()
         )));
     }
-    if points.iter().any(|p| p.roughness == 0.0 && p.percent != 100.0) {
+    if points
+        .iter()
+        .any(|p| p.roughness == 0.0 && p.percent != 100.0)
+    {
         return Err(Error::Fit(
             "a point at roughness 0 must be 100 % (the curve is pinned to f(0) = 100)".into(),
         ));
@@ -208,11 +223,17 @@ pub fn fit_polynomial(
     let a = DMatrix::from_fn(rows, powers.len(), |i, j| {
         weight(weighting, points[i]) * variable.of(points[i].roughness).powi(powers[j])
     });
-    let b = DVector::from_fn(rows, |i, _| weight(weighting, points[i]) * (points[i].percent - 100.0));
+    let b = DVector::from_fn(rows, |i, _| {
+        weight(weighting, points[i]) * (points[i].percent - 100.0)
+    });
     let svd = a.svd(true, true);
-    let smallest = svd.singular_values.iter().cloned().fold(f64::INFINITY, f64::min);
+    let smallest = svd
+        .singular_values
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min);
     let largest = svd.singular_values.iter().cloned().fold(0.0, f64::max);
-    if !(smallest > largest * 1e-13) {
+    if smallest.is_nan() || smallest <= largest * 1e-13 {
         return Err(Error::Fit(
             "the points do not determine the coefficients (too few distinct non-zero roughness values for this degree)".into(),
         ));
@@ -240,10 +261,18 @@ fn weight(weighting: Weighting, p: Point) -> f64 {
 fn check_points(points: &[Point]) -> Result<(), Error> {
     for (i, p) in points.iter().enumerate() {
         if !p.roughness.is_finite() || !(0.0..=1.0).contains(&p.roughness) {
-            return Err(Error::input("point roughness", &p.roughness.to_string(), "a number from 0 to 1"));
+            return Err(Error::input(
+                "point roughness",
+                &p.roughness.to_string(),
+                "a number from 0 to 1",
+            ));
         }
         if !p.percent.is_finite() || p.percent <= 0.0 {
-            return Err(Error::input("point percent", &p.percent.to_string(), "a finite brightness above 0"));
+            return Err(Error::input(
+                "point percent",
+                &p.percent.to_string(),
+                "a finite brightness above 0",
+            ));
         }
         if let Some(q) = points[..i].iter().find(|q| q.roughness == p.roughness) {
             return Err(Error::Fit(format!(
@@ -260,19 +289,33 @@ mod tests {
     use super::*;
 
     fn pts(v: &[(f64, f64)]) -> Vec<Point> {
-        v.iter().map(|&(roughness, percent)| Point { roughness, percent }).collect()
+        v.iter()
+            .map(|&(roughness, percent)| Point { roughness, percent })
+            .collect()
     }
 
     #[test]
     fn seed_two_point_solves_are_exact() {
         // Solved by hand: f(0.5) = 100 + b/4 + a/8, f(1) = 100 + a + b.
-        let b = fit_polynomial(&pts(&[(0.5, 97.0), (1.0, 71.0)]), Variable::Roughness, 3, Weighting::Absolute).unwrap();
+        let b = fit_polynomial(
+            &pts(&[(0.5, 97.0), (1.0, 71.0)]),
+            Variable::Roughness,
+            3,
+            Weighting::Absolute,
+        )
+        .unwrap();
         assert!((b.curve.numerator[3] - -34.0).abs() < 1e-9);
         assert!((b.curve.numerator[2] - 5.0).abs() < 1e-9);
         assert_eq!(b.curve.numerator[1], 0.0);
         assert_eq!(b.curve.numerator[0], 100.0);
         assert!(b.residuals.max_points < 1e-9);
-        let g = fit_polynomial(&pts(&[(0.5, 85.0), (1.0, 59.0)]), Variable::Roughness, 3, Weighting::Absolute).unwrap();
+        let g = fit_polynomial(
+            &pts(&[(0.5, 85.0), (1.0, 59.0)]),
+            Variable::Roughness,
+            3,
+            Weighting::Absolute,
+        )
+        .unwrap();
         assert!((g.curve.numerator[3] - 38.0).abs() < 1e-9);
         assert!((g.curve.numerator[2] - -79.0).abs() < 1e-9);
     }
@@ -281,7 +324,13 @@ mod tests {
     fn least_squares_recovers_a_known_polynomial() {
         // Points on 100 − 20 r² + 7 r⁴ − 3 r⁵, fitted at degree 5: exact recovery.
         let f = |r: f64| 100.0 - 20.0 * r * r + 7.0 * r.powi(4) - 3.0 * r.powi(5);
-        let p: Vec<Point> = (1..=12).map(|i| i as f64 / 12.0).map(|r| Point { roughness: r, percent: f(r) }).collect();
+        let p: Vec<Point> = (1..=12)
+            .map(|i| i as f64 / 12.0)
+            .map(|r| Point {
+                roughness: r,
+                percent: f(r),
+            })
+            .collect();
         for w in [Weighting::Absolute, Weighting::Relative] {
             let fit = fit_polynomial(&p, Variable::Roughness, 5, w).unwrap();
             let want = [100.0, 0.0, -20.0, 0.0, 7.0, -3.0];
@@ -293,15 +342,53 @@ mod tests {
 
     #[test]
     fn refuses_bad_point_sets() {
-        assert!(fit_polynomial(&pts(&[(0.5, 97.0)]), Variable::Roughness, 3, Weighting::Absolute).is_err());
-        assert!(fit_polynomial(&pts(&[(0.5, 97.0), (0.5, 90.0)]), Variable::Roughness, 3, Weighting::Absolute).is_err());
-        assert!(fit_polynomial(&pts(&[(0.5, 97.0), (1.0, 71.0)]), Variable::Roughness, 9, Weighting::Absolute).is_err());
-        assert!(fit_polynomial(&pts(&[(0.5, 97.0), (1.0, 71.0)]), Variable::Roughness, 1, Weighting::Absolute).is_err());
+        assert!(
+            fit_polynomial(
+                &pts(&[(0.5, 97.0)]),
+                Variable::Roughness,
+                3,
+                Weighting::Absolute
+            )
+            .is_err()
+        );
+        assert!(
+            fit_polynomial(
+                &pts(&[(0.5, 97.0), (0.5, 90.0)]),
+                Variable::Roughness,
+                3,
+                Weighting::Absolute
+            )
+            .is_err()
+        );
+        assert!(
+            fit_polynomial(
+                &pts(&[(0.5, 97.0), (1.0, 71.0)]),
+                Variable::Roughness,
+                9,
+                Weighting::Absolute
+            )
+            .is_err()
+        );
+        assert!(
+            fit_polynomial(
+                &pts(&[(0.5, 97.0), (1.0, 71.0)]),
+                Variable::Roughness,
+                1,
+                Weighting::Absolute
+            )
+            .is_err()
+        );
         assert!("0.5".parse::<Point>().is_err());
         assert!("x:97".parse::<Point>().is_err());
         assert!("1.5:97".parse::<Point>().is_err());
         assert!("0.5:NaN".parse::<Point>().is_err());
         assert!("0.5:-3".parse::<Point>().is_err());
-        assert_eq!("0.5:97".parse::<Point>().unwrap(), Point { roughness: 0.5, percent: 97.0 });
+        assert_eq!(
+            "0.5:97".parse::<Point>().unwrap(),
+            Point {
+                roughness: 0.5,
+                percent: 97.0
+            }
+        );
     }
 }

@@ -10,6 +10,7 @@ pub mod coefficients;
 pub mod error;
 pub mod fit;
 pub mod furnace;
+pub mod generate;
 pub mod microfacet;
 pub mod output;
 

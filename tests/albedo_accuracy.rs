@@ -30,7 +30,14 @@ fn closed_form_ashikhmin_shirley_roughness_one_normal_incidence() {
     // n = 0: h uniform over the hemisphere (pdf 1/2π), weight cosθi / max(cosθi, 1) = cosθi
     // = 2cos²θh − 1 for θh < π/4, so E = ∫_{√2/2}^1 (2c² − 1) dc = (√2 − 1)/3.
     let q = AlbedoIntegrator::default();
-    let e = q.directional_albedo(&glossy(Distribution::AshikhminShirley, Masking::HeightCorrelated, 1.0), 1.0);
+    let e = q.directional_albedo(
+        &glossy(
+            Distribution::AshikhminShirley,
+            Masking::HeightCorrelated,
+            1.0,
+        ),
+        1.0,
+    );
     assert!((e - (SQRT_2 - 1.0) / 3.0).abs() < 1e-6, "{e}");
 }
 
@@ -73,11 +80,20 @@ fn matches_brute_force_reference_on_the_whole_domain() {
             let reference = common::brute_force_albedo(g, *mu, 2000, 2000);
             let e = q.directional_albedo(g, *mu);
             ((e - reference).abs() > TOLERANCE).then(|| {
-                format!("{} {} alpha {} mu {mu}: {e} vs {reference}", g.distribution, g.masking, g.alpha)
+                format!(
+                    "{} {} alpha {} mu {mu}: {e} vs {reference}",
+                    g.distribution, g.masking, g.alpha
+                )
             })
         })
         .collect();
-    assert!(failures.is_empty(), "{} of {} cases off:\n{}", failures.len(), cases.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases off:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -212,6 +228,10 @@ fn tables_are_identical_for_any_thread_count() {
     let one = with(1);
     for threads in [2, 3, 7] {
         let other = with(threads);
-        assert!(one.iter().zip(&other).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(
+            one.iter()
+                .zip(&other)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
     }
 }

@@ -11,27 +11,55 @@ fn gloffuse() -> Command {
 }
 
 fn json_of(args: &[&str]) -> Value {
-    let out = gloffuse().args(args).assert().success().get_output().stdout.clone();
+    let out = gloffuse()
+        .args(args)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
     serde_json::from_slice(&out).unwrap()
 }
 
 #[test]
 fn help_and_version() {
-    gloffuse().arg("--version").assert().success().stdout(predicate::str::contains(env!("CARGO_PKG_VERSION")));
     gloffuse()
-        .arg("--help")
+        .arg("--version")
         .assert()
         .success()
-        .stdout(predicate::str::contains("lose energy").and(predicate::str::contains("Exit codes")));
-    gloffuse().args(["albedo", "--help"]).assert().success().stdout(predicate::str::contains("view cosine"));
+        .stdout(predicate::str::contains(env!("CARGO_PKG_VERSION")));
+    gloffuse().arg("--help").assert().success().stdout(
+        predicate::str::contains("lose energy").and(predicate::str::contains("Exit codes")),
+    );
+    gloffuse()
+        .args(["albedo", "--help"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("view cosine"));
 }
 
 #[test]
 fn albedo_matches_closed_forms() {
-    let v = json_of(&["albedo", "--distribution", "GGX", "--roughness", "1", "--json"]);
+    let v = json_of(&[
+        "albedo",
+        "--distribution",
+        "GGX",
+        "--roughness",
+        "1",
+        "--json",
+    ]);
     assert!((v["directional_albedo"].as_f64().unwrap() - (1.0 - LN_2)).abs() < 1e-6);
     assert_eq!(v["masking"], "height-correlated");
-    let v = json_of(&["albedo", "-d", "ASHIKHMIN_SHIRLEY", "-r", "1", "--json", "--blender-version", "3.4"]);
+    let v = json_of(&[
+        "albedo",
+        "-d",
+        "ASHIKHMIN_SHIRLEY",
+        "-r",
+        "1",
+        "--json",
+        "--blender-version",
+        "3.4",
+    ]);
     assert!((v["directional_albedo"].as_f64().unwrap() - (2f64.sqrt() - 1.0) / 3.0).abs() < 1e-6);
     assert_eq!(v["masking"], "separable");
     gloffuse()
@@ -66,13 +94,24 @@ fn albedo_table_writes_a_full_grid() {
 
 #[test]
 fn fit_reproduces_the_seed_exactly() {
-    let v = json_of(&["fit", "-d", "beckmann", "-p", "0.5:97", "-p", "1:71", "--json"]);
+    let v = json_of(&[
+        "fit", "-d", "beckmann", "-p", "0.5:97", "-p", "1:71", "--json",
+    ]);
     let f = &v["fits"][0];
     assert!((f["a"].as_f64().unwrap() + 34.0).abs() < 1e-9);
     assert!((f["b"].as_f64().unwrap() - 5.0).abs() < 1e-9);
     assert_eq!(f["c"].as_f64().unwrap(), 0.0);
     assert_eq!(f["d"].as_f64().unwrap(), 100.0);
-    let v = json_of(&["fit", "--distribution", "GGX", "--point", "0.5:85", "--point", "1:59", "--json"]);
+    let v = json_of(&[
+        "fit",
+        "--distribution",
+        "GGX",
+        "--point",
+        "0.5:85",
+        "--point",
+        "1:59",
+        "--json",
+    ]);
     let f = &v["fits"][0];
     assert!((f["a"].as_f64().unwrap() - 38.0).abs() < 1e-9);
     assert!((f["b"].as_f64().unwrap() + 79.0).abs() < 1e-9);
@@ -88,7 +127,16 @@ fn fit_from_integrator_writes_a_coefficients_file_that_show_reads() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("coefficients.json");
     gloffuse()
-        .args(["fit", "--from", "integrator", "--blender-version", "3.4", "--degree", "6", "--out"])
+        .args([
+            "fit",
+            "--from",
+            "integrator",
+            "--blender-version",
+            "3.4",
+            "--degree",
+            "6",
+            "--out",
+        ])
         .arg(&path)
         .env("SOURCE_DATE_EPOCH", "0")
         .assert()
@@ -96,8 +144,16 @@ fn fit_from_integrator_writes_a_coefficients_file_that_show_reads() {
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     assert_eq!(v["format_version"], 1);
     assert_eq!(v["distributions"]["ggx"]["masking"], "separable");
-    assert_eq!(v["distributions"]["ggx"]["provenance"]["date"], "1970-01-01");
-    assert!(v["distributions"]["ggx"]["residuals"]["max_gain_error"].as_f64().unwrap() < 1e-3);
+    assert_eq!(
+        v["distributions"]["ggx"]["provenance"]["date"],
+        "1970-01-01"
+    );
+    assert!(
+        v["distributions"]["ggx"]["residuals"]["max_gain_error"]
+            .as_f64()
+            .unwrap()
+            < 1e-3
+    );
     gloffuse()
         .args(["coefficients", "show"])
         .arg(&path)
@@ -124,24 +180,78 @@ fn coefficients_show_lists_and_reads_presets() {
 
 /// Each case: arguments, a fragment the error must contain.
 const BAD_INPUT: &[(&[&str], &str)] = &[
-    (&["albedo", "-d", "phong", "-r", "0.5"], "invalid distribution 'phong'"),
-    (&["albedo", "-d", "ggx", "-r", "1.5"], "invalid roughness '1.5'"),
-    (&["albedo", "-d", "ggx", "-r", "-0.1"], "invalid roughness '-0.1'"),
-    (&["albedo", "-d", "ggx", "-r", "NaN"], "invalid roughness 'NaN'"),
-    (&["albedo", "-d", "ggx", "-r", "inf"], "invalid roughness 'inf'"),
-    (&["albedo", "-d", "ggx", "-r", "0.5", "--mu", "0"], "invalid view cosine '0'"),
-    (&["albedo", "-d", "ggx", "-r", "0.5", "--blender-version", "2.79"], "Blender 3.0 or later"),
+    (
+        &["albedo", "-d", "phong", "-r", "0.5"],
+        "invalid distribution 'phong'",
+    ),
+    (
+        &["albedo", "-d", "ggx", "-r", "1.5"],
+        "invalid roughness '1.5'",
+    ),
+    (
+        &["albedo", "-d", "ggx", "-r", "-0.1"],
+        "invalid roughness '-0.1'",
+    ),
+    (
+        &["albedo", "-d", "ggx", "-r", "NaN"],
+        "invalid roughness 'NaN'",
+    ),
+    (
+        &["albedo", "-d", "ggx", "-r", "inf"],
+        "invalid roughness 'inf'",
+    ),
+    (
+        &["albedo", "-d", "ggx", "-r", "0.5", "--mu", "0"],
+        "invalid view cosine '0'",
+    ),
+    (
+        &[
+            "albedo",
+            "-d",
+            "ggx",
+            "-r",
+            "0.5",
+            "--blender-version",
+            "2.79",
+        ],
+        "Blender 3.0 or later",
+    ),
     (&["albedo", "-d", "ggx"], "--roughness"),
     (&["fit", "-d", "ggx", "-p", "0.5"], "invalid point '0.5'"),
-    (&["fit", "-d", "ggx", "-p", "0.5:abc"], "invalid point '0.5:abc'"),
-    (&["fit", "-d", "ggx", "-p", "2:50"], "roughness outside [0, 1]"),
+    (
+        &["fit", "-d", "ggx", "-p", "0.5:abc"],
+        "invalid point '0.5:abc'",
+    ),
+    (
+        &["fit", "-d", "ggx", "-p", "2:50"],
+        "roughness outside [0, 1]",
+    ),
     (&["fit", "-d", "ggx", "-p", "0.5:NaN"], "invalid point"),
-    (&["fit", "-d", "ggx", "-p", "0.5:85", "-p", "0.5:80"], "duplicate roughness 0.5"),
-    (&["fit", "-d", "ggx", "-p", "0.5:85"], "needs at least 2 points"),
-    (&["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "4"], "needs at least 3 points"),
-    (&["fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "9"], "invalid degree '9'"),
+    (
+        &["fit", "-d", "ggx", "-p", "0.5:85", "-p", "0.5:80"],
+        "duplicate roughness 0.5",
+    ),
+    (
+        &["fit", "-d", "ggx", "-p", "0.5:85"],
+        "needs at least 2 points",
+    ),
+    (
+        &[
+            "fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "4",
+        ],
+        "needs at least 3 points",
+    ),
+    (
+        &[
+            "fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "9",
+        ],
+        "invalid degree '9'",
+    ),
     (&["fit", "-p", "0.5:85", "-p", "1:59"], "--distribution"),
-    (&["coefficients", "show", "no-such-preset"], "no such preset or file"),
+    (
+        &["coefficients", "show", "no-such-preset"],
+        "no such preset or file",
+    ),
 ];
 
 #[test]
@@ -149,7 +259,10 @@ fn bad_input_is_refused_clearly() {
     for (args, fragment) in BAD_INPUT {
         let out = gloffuse().args(*args).assert().code(2).get_output().clone();
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(stderr.contains(fragment), "{args:?}: stderr lacks {fragment:?}:\n{stderr}");
+        assert!(
+            stderr.contains(fragment),
+            "{args:?}: stderr lacks {fragment:?}:\n{stderr}"
+        );
         assert!(!stderr.contains("panicked"), "{args:?} panicked");
     }
 }
@@ -173,27 +286,58 @@ fn unwritable_outputs_leave_no_file() {
     // A curve that reaches 0 on [0, 1] would make the gain blow up: refused, nothing written.
     let out = dir.path().join("zero.json");
     gloffuse()
-        .args(["fit", "-d", "ggx", "-p", "0.5:30", "-p", "1:5", "--weighting", "absolute", "--out"])
+        .args([
+            "fit",
+            "-d",
+            "ggx",
+            "-p",
+            "0.5:30",
+            "-p",
+            "1:5",
+            "--weighting",
+            "absolute",
+            "--out",
+        ])
         .arg(&out)
         .assert()
         .code(2)
         .stderr(predicate::str::contains("must stay above 0"));
     assert!(!out.exists());
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "leftover files");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "leftover files"
+    );
 }
 
 #[test]
 fn malformed_coefficient_files_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let good = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/presets/blender-4.json")).unwrap();
+    let good = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/presets/blender-4.json"
+    ))
+    .unwrap();
     let cases = [
         ("not json", "not valid JSON".to_string()),
-        ("{\"format\": \"other\"}", "not a coefficients file".to_string()),
+        (
+            "{\"format\": \"other\"}",
+            "not a coefficients file".to_string(),
+        ),
         ("", "not valid JSON".to_string()),
     ];
-    let mut all: Vec<(String, String)> = cases.iter().map(|(a, b)| (a.to_string(), b.clone())).collect();
-    all.push((good.replace("\"format_version\": 1", "\"format_version\": 7"), "format_version 7 is not supported".into()));
-    all.push((good.replacen("100.0,\n", "100.5,\n", 1), "f(0) must be 100".into()));
+    let mut all: Vec<(String, String)> = cases
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.clone()))
+        .collect();
+    all.push((
+        good.replace("\"format_version\": 1", "\"format_version\": 7"),
+        "format_version 7 is not supported".into(),
+    ));
+    all.push((
+        good.replacen("100.0,\n", "100.5,\n", 1),
+        "f(0) must be 100".into(),
+    ));
     for (i, (text, fragment)) in all.iter().enumerate() {
         let path = dir.path().join(format!("c{i}.json"));
         std::fs::write(&path, text).unwrap();
@@ -202,6 +346,9 @@ fn malformed_coefficient_files_are_refused() {
             .arg(&path)
             .assert()
             .code(2)
-            .stderr(predicate::str::contains(fragment.as_str()).and(predicate::str::contains(path.to_str().unwrap())));
+            .stderr(
+                predicate::str::contains(fragment.as_str())
+                    .and(predicate::str::contains(path.to_str().unwrap())),
+            );
     }
 }

@@ -16,7 +16,11 @@ fn check_scripts(dir: &Path, cases: &[(String, serde_json::Value)]) {
     let reference = dir.join("reference.py");
     std::fs::write(&reference, assemble(&seed_params(), GENERATE_MAIN)).unwrap();
     let mut cmd = Command::new("python3");
-    cmd.arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/blender/check_script.py")).arg(&reference);
+    cmd.arg(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/blender/check_script.py"
+    ))
+    .arg(&reference);
     for (i, (script, expect)) in cases.iter().enumerate() {
         let s = dir.join(format!("case{i}.py"));
         let e = dir.join(format!("case{i}.json"));
@@ -26,8 +30,15 @@ fn check_scripts(dir: &Path, cases: &[(String, serde_json::Value)]) {
     }
     let out = cmd.output().expect("python3 runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains(&format!("{} passed, 0 failed", cases.len())), "{stdout}");
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains(&format!("{} passed, 0 failed", cases.len())),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -39,8 +50,12 @@ fn golden_seed_script_is_byte_stable() {
     if std::env::var_os("GLOFFUSE_BLESS").is_some() {
         std::fs::write(golden_path, &a).unwrap();
     }
-    let golden = std::fs::read_to_string(golden_path).expect("golden file (regenerate with GLOFFUSE_BLESS=1)");
-    assert_eq!(a, golden, "generated script changed; if intended, rerun with GLOFFUSE_BLESS=1 and review the diff");
+    let golden = std::fs::read_to_string(golden_path)
+        .expect("golden file (regenerate with GLOFFUSE_BLESS=1)");
+    assert_eq!(
+        a, golden,
+        "generated script changed; if intended, rerun with GLOFFUSE_BLESS=1 and review the diff"
+    );
     // The golden file is only trusted because it is also checked independently:
     let dir = tempfile::tempdir().unwrap();
     let expect = serde_json::to_value(seed_params()).unwrap();
@@ -66,7 +81,10 @@ fn hostile_text_round_trips_and_never_becomes_code() {
                 g.description = format!("{text}{text}");
                 g.shader_group = format!("Gloffuse {text}");
             }
-            (assemble(&p, GENERATE_MAIN), serde_json::to_value(&p).unwrap())
+            (
+                assemble(&p, GENERATE_MAIN),
+                serde_json::to_value(&p).unwrap(),
+            )
         })
         .collect();
     check_scripts(dir.path(), &cases);

@@ -19,7 +19,10 @@ fn seed_preset_holds_the_hand_made_cubics() {
 #[test]
 fn linear_presets_are_within_a_tenth_of_a_percent() {
     let q = AlbedoIntegrator::default();
-    for (name, masking) in [("blender-3", Masking::Separable), ("blender-4", Masking::HeightCorrelated)] {
+    for (name, masking) in [
+        ("blender-3", Masking::Separable),
+        ("blender-4", Masking::HeightCorrelated),
+    ] {
         let c = Coefficients::load(name).unwrap();
         for d in Distribution::ALL {
             let e = &c.distributions[&d];
@@ -39,11 +42,18 @@ fn shipped_presets_match_a_fresh_fit() {
     for (name, version) in [("blender-3", "3.4"), ("blender-4", "4.5")] {
         let shipped = Coefficients::load(name).unwrap();
         let v: BlenderVersion = version.parse().unwrap();
-        let fresh = Coefficients::from_integrator(v, 6, Target::Mean, Weighting::Relative, None).unwrap();
+        let fresh =
+            Coefficients::from_integrator(v, 6, Target::Mean, Weighting::Relative, None).unwrap();
         for d in Distribution::ALL {
-            let (a, b) = (&shipped.distributions[&d].curve, &fresh.distributions[&d].curve);
+            let (a, b) = (
+                &shipped.distributions[&d].curve,
+                &fresh.distributions[&d].curve,
+            );
             for (x, y) in a.numerator.iter().zip(&b.numerator) {
-                assert!((x - y).abs() < 1e-9, "{name} {d}: regenerate presets/ ({x} vs {y})");
+                assert!(
+                    (x - y).abs() < 1e-9,
+                    "{name} {d}: regenerate presets/ ({x} vs {y})"
+                );
             }
         }
     }
@@ -52,7 +62,21 @@ fn shipped_presets_match_a_fresh_fit() {
 #[test]
 fn coefficient_files_are_byte_identical_for_equal_inputs() {
     let v: BlenderVersion = "4.5".parse().unwrap();
-    let a = Coefficients::from_integrator(v, 6, Target::Mean, Weighting::Relative, Some("2026-01-01".into())).unwrap();
-    let b = Coefficients::from_integrator(v, 6, Target::Mean, Weighting::Relative, Some("2026-01-01".into())).unwrap();
+    let a = Coefficients::from_integrator(
+        v,
+        6,
+        Target::Mean,
+        Weighting::Relative,
+        Some("2026-01-01".into()),
+    )
+    .unwrap();
+    let b = Coefficients::from_integrator(
+        v,
+        6,
+        Target::Mean,
+        Weighting::Relative,
+        Some("2026-01-01".into()),
+    )
+    .unwrap();
     assert_eq!(a.to_json(), b.to_json());
 }

@@ -294,8 +294,15 @@ fn probe_as(program: &Path, kind: Option<BlenderKind>, source: Source) -> Result
         program.to_path_buf()
     } else if program.exists() || program.symlink_metadata().is_ok() {
         return Err(named("is not a file (a broken link?)"));
+    } else if let Some(found) = program
+        .to_str()
+        .filter(|s| !s.contains('/'))
+        .and_then(|name| which(name, std::env::var_os("PATH").as_deref()))
+    {
+        // A bare command name (`--blender blender`, `--blender python3`) is looked up on PATH.
+        found
     } else {
-        return Err(named("no such file"));
+        return Err(named("no such file (nor a command of that name on PATH)"));
     };
     let looks_like_python = program
         .file_name()

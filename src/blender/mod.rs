@@ -1,9 +1,9 @@
 //! Everything about Blender itself: versions, finding (or installing) it, and running
 //! scripts in it headless.
 
-pub mod script;
 pub mod discover;
 pub mod run;
+pub mod script;
 pub mod version;
 
 pub use discover::{Blender, BlenderKind, FindOptions, find_blender};

@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-use crate::coefficients::{ColorSpace, Coefficients, Target};
+use crate::coefficients::{Coefficients, ColorSpace, Target};
 use crate::fit::Curve;
 use crate::microfacet::Distribution;
 

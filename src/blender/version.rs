@@ -88,8 +88,14 @@ mod tests {
         let v: BlenderVersion = "3.4.1".parse().unwrap();
         assert_eq!(v, BlenderVersion { major: 3, minor: 4 });
         assert_eq!(v.masking(), Masking::Separable);
-        assert_eq!("4.5".parse::<BlenderVersion>().unwrap().masking(), Masking::HeightCorrelated);
-        assert_eq!("5.0".parse::<BlenderVersion>().unwrap().preset_name(), "blender-4");
+        assert_eq!(
+            "4.5".parse::<BlenderVersion>().unwrap().masking(),
+            Masking::HeightCorrelated
+        );
+        assert_eq!(
+            "5.0".parse::<BlenderVersion>().unwrap().preset_name(),
+            "blender-4"
+        );
         assert!("2.79".parse::<BlenderVersion>().is_err());
         assert!("four".parse::<BlenderVersion>().is_err());
         assert!("4".parse::<BlenderVersion>().is_err());

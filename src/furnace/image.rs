@@ -21,12 +21,18 @@ pub enum ExrError {
     #[error("EXR {} uses a feature gloffuse cannot read ({why}); write single-layer OPEN_EXR, 32-bit float, ZIP", path.display())]
     Unsupported { path: PathBuf, why: String },
     #[error("EXR {} has no {channel} channel (found: {found}); gloffuse needs R, G, B and A", path.display())]
-    MissingChannel { path: PathBuf, channel: &'static str, found: String },
+    MissingChannel {
+        path: PathBuf,
+        channel: &'static str,
+        found: String,
+    },
 }
 
 pub fn read_rgba(path: &Path) -> std::result::Result<Rgba, ExrError> {
     if !path.exists() {
-        return Err(ExrError::Missing { path: path.to_path_buf() });
+        return Err(ExrError::Missing {
+            path: path.to_path_buf(),
+        });
     }
     let image = read()
         .no_deep_data()
@@ -36,8 +42,14 @@ pub fn read_rgba(path: &Path) -> std::result::Result<Rgba, ExrError> {
         .all_attributes()
         .from_file(path)
         .map_err(|e| match e {
-            exr::error::Error::NotSupported(what) => ExrError::Unsupported { path: path.to_path_buf(), why: what.to_string() },
-            other => ExrError::Corrupt { path: path.to_path_buf(), why: other.to_string() },
+            exr::error::Error::NotSupported(what) => ExrError::Unsupported {
+                path: path.to_path_buf(),
+                why: what.to_string(),
+            },
+            other => ExrError::Corrupt {
+                path: path.to_path_buf(),
+                why: other.to_string(),
+            },
         })?;
     let layer = &image.layer_data;
     let size = layer.size;
@@ -48,9 +60,17 @@ pub fn read_rgba(path: &Path) -> std::result::Result<Rgba, ExrError> {
             .iter()
             .find(|c| c.name.to_string() == want)
             .map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
-            .ok_or_else(|| ExrError::MissingChannel { path: path.to_path_buf(), channel: want, found: names.join(", ") })
+            .ok_or_else(|| ExrError::MissingChannel {
+                path: path.to_path_buf(),
+                channel: want,
+                found: names.join(", "),
+            })
     };
     let (r, g, b, a) = (find("R")?, find("G")?, find("B")?, find("A")?);
     let pixels = (0..size.area()).map(|i| [r[i], g[i], b[i], a[i]]).collect();
-    Ok(Rgba { width: size.width(), height: size.height(), pixels })
+    Ok(Rgba {
+        width: size.width(),
+        height: size.height(),
+        pixels,
+    })
 }

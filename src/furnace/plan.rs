@@ -61,7 +61,12 @@ pub struct Plan {
 impl Plan {
     /// The verify sweep: for each distribution (in `groups` order) an uncorrected row and a
     /// corrected row over `roughness`, then the Multiscatter GGX reference row.
-    pub fn verify(distributions: &[Distribution], roughness: &[f64], settings: RenderSettings, reference: bool) -> Self {
+    pub fn verify(
+        distributions: &[Distribution],
+        roughness: &[f64],
+        settings: RenderSettings,
+        reference: bool,
+    ) -> Self {
         let mut cells = Vec::new();
         for &d in distributions {
             for role in [Role::Uncorrected(d), Role::Corrected(d)] {
@@ -69,18 +74,38 @@ impl Plan {
             }
         }
         if reference {
-            cells.extend(roughness.iter().map(|&r| Cell { role: Role::Reference, roughness: r }));
+            cells.extend(roughness.iter().map(|&r| Cell {
+                role: Role::Reference,
+                roughness: r,
+            }));
         }
-        Plan { cells, columns: roughness.len(), settings }
+        Plan {
+            cells,
+            columns: roughness.len(),
+            settings,
+        }
     }
 
     /// Uncorrected spheres only (what `refresh` measures).
-    pub fn measure(distributions: &[Distribution], roughness: &[f64], settings: RenderSettings) -> Self {
+    pub fn measure(
+        distributions: &[Distribution],
+        roughness: &[f64],
+        settings: RenderSettings,
+    ) -> Self {
         let cells = distributions
             .iter()
-            .flat_map(|&d| roughness.iter().map(move |&r| Cell { role: Role::Uncorrected(d), roughness: r }))
+            .flat_map(|&d| {
+                roughness.iter().map(move |&r| Cell {
+                    role: Role::Uncorrected(d),
+                    roughness: r,
+                })
+            })
             .collect();
-        Plan { cells, columns: roughness.len(), settings }
+        Plan {
+            cells,
+            columns: roughness.len(),
+            settings,
+        }
     }
 
     pub fn rows(&self) -> usize {
@@ -100,9 +125,18 @@ impl Plan {
             .cells
             .iter()
             .map(|c| match c.role {
-                Role::Uncorrected(d) => SphereSpec::Plain { distribution: d.blender_enum(), roughness: c.roughness },
-                Role::Reference => SphereSpec::Plain { distribution: "MULTI_GGX", roughness: c.roughness },
-                Role::Corrected(d) => SphereSpec::Group { group: shader_of(d).shader_group.clone(), roughness: c.roughness },
+                Role::Uncorrected(d) => SphereSpec::Plain {
+                    distribution: d.blender_enum(),
+                    roughness: c.roughness,
+                },
+                Role::Reference => SphereSpec::Plain {
+                    distribution: "MULTI_GGX",
+                    roughness: c.roughness,
+                },
+                Role::Corrected(d) => SphereSpec::Group {
+                    group: shader_of(d).shader_group.clone(),
+                    roughness: c.roughness,
+                },
             })
             .collect();
         FurnaceParams {
@@ -124,8 +158,14 @@ impl Plan {
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "shader", rename_all = "kebab-case")]
 pub enum SphereSpec {
-    Plain { distribution: &'static str, roughness: f64 },
-    Group { group: String, roughness: f64 },
+    Plain {
+        distribution: &'static str,
+        roughness: f64,
+    },
+    Group {
+        group: String,
+        roughness: f64,
+    },
 }
 
 #[derive(Clone, Debug, Serialize)]

@@ -34,7 +34,13 @@ pub struct SphereStats {
 
 /// Statistics of cell `index` in a grid of `columns` cells of `cell` pixels, where the
 /// sphere's diameter is `radius_fraction` of the cell.
-pub fn sphere_stats(img: &Rgba, index: usize, columns: usize, cell: usize, radius_fraction: f64) -> SphereStats {
+pub fn sphere_stats(
+    img: &Rgba,
+    index: usize,
+    columns: usize,
+    cell: usize,
+    radius_fraction: f64,
+) -> SphereStats {
     let (col, row) = (index % columns, index / columns);
     let (x0, y0) = (col * cell, row * cell);
     let centre = cell as f64 / 2.0;
@@ -68,7 +74,11 @@ pub fn sphere_stats(img: &Rgba, index: usize, columns: usize, cell: usize, radiu
             }
         }
     }
-    let mean = if sum_a > 0.0 { sum_rgb / sum_a } else { f64::NAN };
+    let mean = if sum_a > 0.0 {
+        sum_rgb / sum_a
+    } else {
+        f64::NAN
+    };
     // Pixel noise is independent between pixels; within a ring all pixels share (nearly)
     // one expected value, so the ring's sample variance estimates each pixel's variance.
     let mut var_sum = 0.0;
@@ -76,20 +86,36 @@ pub fn sphere_stats(img: &Rgba, index: usize, columns: usize, cell: usize, radiu
     let rings = (0..RINGS)
         .map(|k| {
             let n = ring_n[k];
-            let m = if n > 0 { ring_sum[k] / n as f64 } else { f64::NAN };
+            let m = if n > 0 {
+                ring_sum[k] / n as f64
+            } else {
+                f64::NAN
+            };
             if n > 1 {
                 let var = (ring_sq[k] - n as f64 * m * m) / (n as f64 - 1.0);
                 var_sum += var.max(0.0) * n as f64;
             }
             n_total += n;
-            Ring { mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64), pixels: n, mean: m }
+            Ring {
+                mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64),
+                pixels: n,
+                mean: m,
+            }
         })
         .collect();
-    let standard_error = if n_total > 0 { var_sum.sqrt() / n_total as f64 } else { f64::NAN };
+    let standard_error = if n_total > 0 {
+        var_sum.sqrt() / n_total as f64
+    } else {
+        f64::NAN
+    };
     SphereStats {
         mean,
         standard_error,
-        center: if centre_n > 0 { centre_sum / centre_n as f64 } else { f64::NAN },
+        center: if centre_n > 0 {
+            centre_sum / centre_n as f64
+        } else {
+            f64::NAN
+        },
         coverage: sum_a / (cell * cell) as f64,
         rings,
     }

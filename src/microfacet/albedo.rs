@@ -226,7 +226,10 @@ impl AlbedoIntegrator {
         let theta_a = 0.5 * (FRAC_PI_2 - theta_o);
         let theta_b = 0.5 * (FRAC_PI_2 + theta_o);
         let mut cuts = vec![0.0, theta_a, theta_b];
-        for t in [0.5 * (kappa.acos() - theta_o), 0.5 * (kappa.acos() + theta_o)] {
+        for t in [
+            0.5 * (kappa.acos() - theta_o),
+            0.5 * (kappa.acos() + theta_o),
+        ] {
             if t > 0.0 && t < theta_b && (t - theta_a).abs() > 1e-12 {
                 cuts.push(t);
             }
@@ -260,7 +263,9 @@ impl AlbedoIntegrator {
                 let piece: f64 = self
                     .theta_rule
                     .iter()
-                    .map(|&(x, w)| w * azimuth(Self::polar_from_survival(glossy, s_lo + (s_hi - s_lo) * x)))
+                    .map(|&(x, w)| {
+                        w * azimuth(Self::polar_from_survival(glossy, s_lo + (s_hi - s_lo) * x))
+                    })
                     .sum();
                 total += piece * (s_hi - s_lo);
             } else {
@@ -307,6 +312,8 @@ impl AlbedoIntegrator {
 
     /// `E_avg(r_j)` for every roughness, in parallel.
     pub fn average_table(&self, make: impl Fn(f64) -> Glossy + Sync, rs: &[f64]) -> Vec<f64> {
-        rs.par_iter().map(|&r| self.average_albedo(&make(r))).collect()
+        rs.par_iter()
+            .map(|&r| self.average_albedo(&make(r)))
+            .collect()
     }
 }

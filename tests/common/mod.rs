@@ -34,3 +34,57 @@ pub fn brute_force_albedo(glossy: &Glossy, mu: f64, nx: usize, nphi: usize) -> f
     }
     sum * (2.0 * PI / nphi as f64) / nx as f64
 }
+
+/// The real Blenders the end-to-end tests run in: (label, program). Each comes from an
+/// environment variable (set by scripts/test.sh) or a default path; a missing one fails the
+/// test under CI (no silent skips there) and is skipped with a message elsewhere.
+pub fn real_blenders() -> Vec<(&'static str, std::path::PathBuf)> {
+    let known = [
+        ("3.4", "GLOFFUSE_TEST_BLENDER_34", "/usr/bin/blender"),
+        ("4.5", "GLOFFUSE_TEST_BPY_45", "/opt/bpy45/bin/python"),
+        ("5.0", "GLOFFUSE_TEST_BPY_50", "/opt/bpy50/bin/python"),
+    ];
+    let mut found = Vec::new();
+    for (label, var, default) in known {
+        let path =
+            std::env::var_os(var).map_or_else(|| std::path::PathBuf::from(default), Into::into);
+        if path.exists() {
+            found.push((label, path));
+        } else {
+            let why = format!(
+                "Blender {label}: {} not found (set {var}, or run scripts/test.sh)",
+                path.display()
+            );
+            assert!(std::env::var_os("CI").is_none(), "CI: {why}");
+            eprintln!("skipped: {why}");
+        }
+    }
+    found
+}
+
+/// Runs a Python file inside `blender` (an executable or a bpy Python) with script args.
+pub fn run_in_blender(
+    blender: &std::path::Path,
+    script: &std::path::Path,
+    args: &[&std::ffi::OsStr],
+) -> std::process::Output {
+    let is_binary = blender
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().starts_with("blender"));
+    let mut cmd = std::process::Command::new(blender);
+    if is_binary {
+        cmd.args([
+            "-b",
+            "--factory-startup",
+            "-noaudio",
+            "--python-exit-code",
+            "1",
+            "--python",
+        ])
+        .arg(script)
+        .arg("--");
+    } else {
+        cmd.arg(script);
+    }
+    cmd.args(args).output().expect("Blender starts")
+}

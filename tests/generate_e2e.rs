@@ -1,0 +1,155 @@
+//! `gloffuse generate` end to end in real Blender 3.4, 4.5 and 5.0: the .blend it writes
+//! holds the public groups with their exact sockets, defaults and asset marks, and Cycles
+//! itself, evaluating the groups, gives gains equal to 100/f(r) from the coefficients
+//! (computed here in Rust: an independent evaluation of the same curve).
+
+mod common;
+
+use assert_cmd::Command;
+use gloffuse::blender::script::{correction_group_name, shader_group_name};
+use gloffuse::coefficients::Coefficients;
+use serde_json::{Value, json};
+
+const PROBES: [f64; 6] = [0.0, 0.2, 0.5, 0.75, 1.0, 1.5];
+
+fn expectations(preset: &str) -> Value {
+    let c = Coefficients::load(preset).unwrap();
+    let groups: Vec<Value> = c
+        .distributions
+        .iter()
+        .map(|(&d, e)| {
+            json!({
+                "correction_group": correction_group_name(d),
+                "shader_group": shader_group_name(d),
+                "distribution": d.blender_enum(),
+                // r = 1.5 probes the clamp: Blender must treat it as 1.
+                "probe": PROBES.iter().map(|&r| json!([r, e.curve.gain(r.min(1.0))])).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    json!({ "groups": groups })
+}
+
+#[test]
+fn generated_blend_works_in_every_blender() {
+    let checker = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/blender/check_generated.py"
+    );
+    for (label, blender) in common::real_blenders() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("a dir é 'q\"");
+        std::fs::create_dir(&sub).unwrap();
+        let blend = sub.join("gloffuse library.blend");
+        let script = sub.join("gen erate.py");
+        let preset = if label == "3.4" {
+            "blender-3"
+        } else {
+            "blender-4"
+        };
+        let out = Command::cargo_bin("gloffuse")
+            .unwrap()
+            .args(["generate", "--json", "--blend"])
+            .arg(&blend)
+            .arg("--script")
+            .arg(&script)
+            .arg("--blender")
+            .arg(&blender)
+            .args(["--no-provision", "--timeout", "300"])
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        let summary: Value = serde_json::from_slice(&out).unwrap();
+        // Without --coefficients the preset follows the Blender's masking family.
+        assert_eq!(summary["coefficients"], preset, "Blender {label}");
+        assert!(summary["blender"].as_str().unwrap().starts_with(label));
+        let leftovers: Vec<_> = std::fs::read_dir(&sub)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(
+            leftovers.len(),
+            2,
+            "Blender {label}: only the .blend and the script: {leftovers:?}"
+        );
+
+        let expect = dir.path().join("expect.json");
+        std::fs::write(&expect, expectations(preset).to_string()).unwrap();
+        let result = dir.path().join("result.json");
+        let run = common::run_in_blender(
+            &blender,
+            checker.as_ref(),
+            &[
+                "--blend".as_ref(),
+                blend.as_os_str(),
+                "--expect".as_ref(),
+                expect.as_os_str(),
+                "--out".as_ref(),
+                result.as_os_str(),
+                "--generator".as_ref(),
+                script.as_os_str(),
+            ],
+        );
+        let report: Value = std::fs::read_to_string(&result)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or(Value::Null);
+        assert!(
+            run.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
+            "Blender {label}: check_generated failed\nfailures: {}\nstdout:\n{}\nstderr:\n{}",
+            report["failures"],
+            String::from_utf8_lossy(&run.stdout),
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+}
+
+#[test]
+fn into_replaces_groups_in_place_and_keeps_a_backup() {
+    let Some((_, blender)) = common::real_blenders()
+        .into_iter()
+        .find(|(l, _)| *l == "4.5")
+    else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let blend = dir.path().join("scene.blend");
+    let run = |coefficients: &str| {
+        Command::cargo_bin("gloffuse")
+            .unwrap()
+            .args(["generate", "--coefficients", coefficients, "--into"])
+            .arg(&blend)
+            .arg("--blender")
+            .arg(&blender)
+            .arg("--no-provision")
+            .assert()
+    };
+    // --into needs an existing file: refused, nothing created.
+    run("seed")
+        .code(2)
+        .stderr(predicates::str::contains("an existing .blend file"));
+    assert!(!blend.exists());
+    Command::cargo_bin("gloffuse")
+        .unwrap()
+        .args(["generate", "--coefficients", "seed", "--blend"])
+        .arg(&blend)
+        .arg("--blender")
+        .arg(&blender)
+        .assert()
+        .success();
+    let first = std::fs::read(&blend).unwrap();
+    run("blender-4").success();
+    let backup = dir.path().join("scene.blend1");
+    assert_eq!(
+        std::fs::read(&backup).unwrap(),
+        first,
+        "the .blend1 holds the previous file"
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+}
