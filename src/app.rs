@@ -44,6 +44,21 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
             }
             Ok(0)
         }
+        Command::Verify(v) => {
+            let (report, rendered) = crate::verify::verify(&v)?;
+            if let (Some(dir), Some(rendered)) = (&v.report, &rendered) {
+                let written = crate::verify::write_report_files(dir, &report, rendered)?;
+                for p in written {
+                    eprintln!("wrote {}", p.display());
+                }
+            }
+            if v.json {
+                println!("{}", serde_json::to_string_pretty(&report).expect("json"));
+            } else {
+                print!("{}", crate::verify::table(&report));
+            }
+            Ok(if report.pass { 0 } else { 1 })
+        }
         Command::Coefficients {
             action: CoefficientsCommand::Show { source, json },
         } => show(source, json),

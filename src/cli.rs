@@ -46,6 +46,14 @@ pub enum Command {
     /// needs no Blender; --blend and --into run Blender headless (found or installed
     /// automatically, see --blender).
     Generate(GenerateArgs),
+    /// Render furnace spheres in Blender and check that corrected ones come out at 100 %.
+    ///
+    /// One headless Blender process renders, for each distribution and roughness, a white
+    /// sphere under a uniform white sky with the plain Glossy BSDF and with the `Gloffuse (…)`
+    /// group built by the same script `generate` writes, plus Blender's own Multiscatter GGX
+    /// as a reference. A sphere's mean brightness (Σ RGB / Σ alpha) must be 100 % ± tolerance.
+    /// Exit code 0: all corrected spheres pass; 1: some failed; 2: bad input or Blender error.
+    Verify(VerifyArgs),
     /// Inspect coefficient files and the built-in presets.
     Coefficients {
         #[command(subcommand)]
@@ -179,6 +187,59 @@ pub struct GenerateArgs {
     /// Print a JSON summary instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// A preset (seed, blender-3, blender-4) or a coefficients file [default: the preset of
+    /// the Blender used].
+    #[arg(long, value_name = "PRESET|FILE")]
+    pub coefficients: Option<String>,
+
+    /// Distributions to check, comma-separated [default: all in the coefficients].
+    #[arg(long, short = 'd', value_delimiter = ',', value_parser = parse_distribution)]
+    pub distribution: Vec<Distribution>,
+
+    /// Roughness values, comma-separated.
+    #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness, allow_hyphen_values = true,
+          default_value = "0,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1")]
+    pub roughness: Vec<Roughness>,
+
+    /// Cycles samples per pixel (32 keeps each sphere's standard error ≤ 0.2 %).
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
+
+    /// Pixels across each sphere's cell.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    pub resolution: u32,
+
+    /// Allowed |mean − 100 %| of a corrected sphere, in percent.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_tolerance)]
+    pub tolerance: f64,
+
+    /// Cycles' random seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+
+    /// Also write report.json, the rendered sweep.exr, contact-sheet.png and brightness.png here.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+
+    /// Print the JSON report instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_tolerance(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 100.0 => Ok(v),
+        _ => Err(format!(
+            "invalid tolerance '{s}': expected a percentage above 0 and at most 100, e.g. 1"
+        )),
+    }
 }
 
 #[derive(Subcommand, Debug)]

@@ -42,6 +42,10 @@ pub enum Error {
         command: Option<String>,
     },
 
+    /// A rendered EXR could not be read back.
+    #[error(transparent)]
+    Exr(#[from] crate::furnace::image::ExrError),
+
     /// No usable Blender: the message says where gloffuse looked and how to point at one.
     #[error("{0}")]
     BlenderNotFound(String),

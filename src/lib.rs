@@ -13,5 +13,6 @@ pub mod furnace;
 pub mod generate;
 pub mod microfacet;
 pub mod output;
+pub mod verify;
 
 pub use error::{Error, Result};

@@ -31,6 +31,21 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         .tempfile_in(dir)
         .map_err(|e| fail(e.to_string()))?;
     tmp.write_all(bytes).map_err(|e| fail(e.to_string()))?;
+    // Temporary files are created private (0600); an output file should be as readable as
+    // any other file the user writes.
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = if path.exists() {
+            std::fs::metadata(path)
+                .map(|m| m.permissions().mode())
+                .unwrap_or(0o644)
+        } else {
+            0o644
+        };
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(mode))
+            .map_err(|e| fail(e.to_string()))?;
+    }
     tmp.as_file().sync_all().map_err(|e| fail(e.to_string()))?;
     tmp.persist(path).map_err(|e| fail(e.error.to_string()))?;
     Ok(())

@@ -154,9 +154,17 @@ fn agrees_with_blender_measurements() {
     assert!((centre(Distribution::Beckmann, 0.5) - 1.000).abs() < 0.005);
     assert!((centre(Distribution::Beckmann, 1.0) - 0.4615).abs() < 0.005);
     assert!((centre(Distribution::AshikhminShirley, 1.0) - 0.139).abs() < 0.005);
-    let mean = |m| q.average_albedo(&glossy(Distribution::Ggx, m, 1.0));
-    assert!((mean(Masking::HeightCorrelated) - 0.409).abs() < 0.004); // Blender 4.5
-    assert!((mean(Masking::Separable) - 0.377).abs() < 0.004); // Blender 3.4
+    let mean = |d, m| q.average_albedo(&glossy(d, m, 1.0));
+    assert!((mean(Distribution::Ggx, Masking::HeightCorrelated) - 0.409).abs() < 0.003); // Blender 4.5
+    assert!((mean(Distribution::Ggx, Masking::Separable) - 0.377).abs() < 0.003); // Blender 3.4
+    // Rendered furnace sphere means at 512 spp, 64 px (3.4, 4.5 and 5.0 agree): Beckmann r = 1
+    // 0.6588 (3.4) / 0.6637 (4.5); Ashikhmin–Shirley r = 1 0.2402–0.2404, which only the
+    // model of Cycles' flipped-half-vector samples reproduces (the BSDF alone gives 0.2146).
+    assert!((mean(Distribution::Beckmann, Masking::Separable) - 0.6588).abs() < 0.003);
+    assert!((mean(Distribution::Beckmann, Masking::HeightCorrelated) - 0.6637).abs() < 0.003);
+    assert!(
+        (mean(Distribution::AshikhminShirley, Masking::HeightCorrelated) - 0.2403).abs() < 0.002
+    );
 }
 
 #[test]

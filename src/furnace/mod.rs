@@ -2,4 +2,6 @@
 
 pub mod image;
 pub mod plan;
+pub mod png;
+pub mod report;
 pub mod stats;
