@@ -46,8 +46,8 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
         }
         Command::Verify(v) => {
             let (report, rendered) = crate::verify::verify(&v)?;
-            if let (Some(dir), Some(rendered)) = (&v.report, &rendered) {
-                let written = crate::verify::write_report_files(dir, &report, rendered)?;
+            if let Some(dir) = &v.report {
+                let written = crate::verify::write_report_files(dir, &report, &rendered)?;
                 for p in written {
                     eprintln!("wrote {}", p.display());
                 }
@@ -58,6 +58,29 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
                 print!("{}", crate::verify::table(&report));
             }
             Ok(if report.pass { 0 } else { 1 })
+        }
+        Command::Refresh(a) => {
+            let r = crate::refresh::refresh(&a)?;
+            if a.json {
+                println!("{}", serde_json::to_string_pretty(&r).expect("json"));
+            } else {
+                print!("{}", crate::refresh::table(&r));
+                if let Some(v) = &r.verify {
+                    print!("\n{}", crate::verify::table(v));
+                }
+            }
+            Ok(match &r.verify {
+                Some(v) if !v.pass => 1,
+                _ => 0,
+            })
+        }
+        Command::Bench(b) => {
+            let r = crate::refresh::bench(&b)?;
+            println!(
+                "{} spheres: one Blender process {:.1} s, one process per sphere {:.1} s: {:.1}× faster",
+                r.spheres, r.one_process_seconds, r.per_sphere_seconds, r.ratio
+            );
+            Ok(0)
         }
         Command::Coefficients {
             action: CoefficientsCommand::Show { source, json },

@@ -54,6 +54,16 @@ pub enum Command {
     /// as a reference. A sphere's mean brightness (Σ RGB / Σ alpha) must be 100 % ± tolerance.
     /// Exit code 0: all corrected spheres pass; 1: some failed; 2: bad input or Blender error.
     Verify(VerifyArgs),
+    /// Measure E_avg in your Blender, fit new coefficients from it, then verify them.
+    ///
+    /// Renders plain Glossy furnace spheres of every distribution on a roughness grid, fits
+    /// f(r) to their mean brightness with the same fitter as `fit`, writes a coefficients
+    /// file whose provenance names this Blender, compares the measurement with the
+    /// integrator's prediction (a disagreement above 0.5 % is a warning), and runs `verify`
+    /// with the new file.
+    Refresh(RefreshArgs),
+    /// Time the verify sweep as one Blender process against one process per sphere.
+    Bench(BenchArgs),
     /// Inspect coefficient files and the built-in presets.
     Coefficients {
         #[command(subcommand)]
@@ -231,6 +241,51 @@ pub struct VerifyArgs {
     /// Print the JSON report instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct RefreshArgs {
+    /// Where to write the new coefficients file (atomically).
+    #[arg(long, value_name = "FILE.json", default_value = "coefficients.json")]
+    pub out: PathBuf,
+
+    /// Polynomial degree in r (6 keeps every distribution within 0.1 % of the measurement).
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u64).range(2..=8))]
+    pub degree: u64,
+
+    /// Cycles samples per pixel for the measurement.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
+
+    /// Pixels across each sphere's cell.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    pub resolution: u32,
+
+    /// Skip the verify run with the new coefficients.
+    #[arg(long)]
+    pub no_verify: bool,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Roughness values of the sweep, comma-separated (the default is verify's sweep).
+    #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness,
+          default_value = "0,0.1,0.2,0.3,0.4,0.5,0.6,0.7,0.8,0.9,1")]
+    pub roughness: Vec<Roughness>,
+
+    /// Cycles samples per pixel.
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
 }
 
 fn parse_tolerance(s: &str) -> Result<f64, String> {

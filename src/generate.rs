@@ -34,22 +34,6 @@ pub fn blender_from(args: &BlenderArgs, quiet: bool) -> Result<Blender, Error> {
     Ok(b)
 }
 
-/// A log file for one Blender run, in the cache directory (or the temp directory).
-pub fn log_path(job: &str) -> Result<PathBuf, Error> {
-    let env = crate::blender::discover::Environment::from_process();
-    let dir = crate::blender::discover::cache_dir(&env)
-        .unwrap_or_else(std::env::temp_dir)
-        .join("logs");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::Write {
-        path: dir.clone(),
-        message: e.to_string(),
-    })?;
-    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())
-        .to_string()
-        .replace(':', "");
-    Ok(dir.join(format!("{job}-{stamp}-{}.log", std::process::id())))
-}
-
 /// A temporary file next to `dest`, removed on drop unless persisted.
 fn temp_beside(dest: &Path, suffix: &str) -> Result<tempfile::TempPath, Error> {
     let dir = match dest.parent() {
@@ -144,11 +128,8 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
         return Ok(out);
     };
 
-    let work = tempfile::tempdir().map_err(|e| Error::Write {
-        path: std::env::temp_dir(),
-        message: e.to_string(),
-    })?;
-    let script_path = work.path().join("gloffuse-generate.py");
+    let run_dir = crate::blender::runs::new_run_dir("generate")?;
+    let script_path = run_dir.join("gloffuse-generate.py");
     write_atomic(&script_path, script.as_bytes())?;
     let dest = g
         .blend
@@ -161,7 +142,7 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
         args.extend([OsString::from("--open"), into.clone().into_os_string()]);
     }
     args.extend([OsString::from("--save"), tmp.to_path_buf().into_os_string()]);
-    let log = log_path("generate")?;
+    let log = run_dir.join("blender.log");
     run_script(&Run {
         blender: &blender,
         script: &script_path,

@@ -13,6 +13,7 @@ pub mod furnace;
 pub mod generate;
 pub mod microfacet;
 pub mod output;
+pub mod refresh;
 pub mod verify;
 
 pub use error::{Error, Result};

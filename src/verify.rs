@@ -16,7 +16,7 @@ use crate::furnace::image::{Rgba, read_rgba};
 use crate::furnace::plan::{Plan, RenderSettings, Role};
 use crate::furnace::report::{ReferenceSphere, RenderInfo, Row, VerifyReport};
 use crate::furnace::stats::{SphereStats, sphere_stats};
-use crate::generate::{blender_from, log_path};
+use crate::generate::blender_from;
 use crate::microfacet::{AlbedoIntegrator, Distribution, Glossy, Roughness};
 use crate::output::write_atomic;
 
@@ -25,10 +25,9 @@ pub struct Rendered {
     pub image: Rgba,
     pub stats: Vec<SphereStats>,
     pub info: RenderInfo,
-    /// The EXR, inside `_work` (kept alive until the caller is done with it).
+    /// The EXR, in the run's directory beside its script and log.
     pub exr: PathBuf,
     pub plan: Plan,
-    _work: tempfile::TempDir,
 }
 
 /// Renders `plan` in one Blender process, with a progress bar fed by Blender's log.
@@ -39,15 +38,12 @@ pub fn render(
     timeout: u64,
     quiet: bool,
 ) -> Result<Rendered, Error> {
-    let work = tempfile::tempdir().map_err(|e| Error::Write {
-        path: std::env::temp_dir(),
-        message: e.to_string(),
-    })?;
-    let exr = work.path().join("sweep.exr");
+    let run_dir = crate::blender::runs::new_run_dir("verify")?;
+    let exr = run_dir.join("sweep.exr");
     let params = plan.params(groups, &exr);
-    let script = work.path().join("gloffuse-furnace.py");
+    let script = run_dir.join("gloffuse-furnace.py");
     write_atomic(&script, assemble(&params, FURNACE_MAIN).as_bytes())?;
-    let log = log_path("verify")?;
+    let log = run_dir.join("blender.log");
     let run = Run {
         blender,
         script: &script,
@@ -134,7 +130,6 @@ pub fn render(
         info,
         exr,
         plan: plan.clone(),
-        _work: work,
     })
 }
 
@@ -148,7 +143,18 @@ fn last_sample(log: &Path) -> Option<u64> {
     n.parse().ok()
 }
 
-pub fn verify(v: &VerifyArgs) -> Result<(VerifyReport, Option<Rendered>), Error> {
+/// Checks the arguments, finds Blender, then [`verify_with`].
+pub fn verify(v: &VerifyArgs) -> Result<(VerifyReport, Rendered), Error> {
+    check_args(v)?;
+    // Coefficients are loaded before Blender is looked for: bad input fails fast.
+    if let Some(c) = &v.coefficients {
+        Coefficients::load(c)?;
+    }
+    let blender = blender_from(&v.blender, v.json)?;
+    verify_with(&blender, v)
+}
+
+fn check_args(v: &VerifyArgs) -> Result<(), Error> {
     let mut seen = Vec::new();
     for r in &v.roughness {
         if seen.contains(&r.get()) {
@@ -169,12 +175,18 @@ pub fn verify(v: &VerifyArgs) -> Result<(VerifyReport, Option<Rendered>), Error>
             message: "--report needs a directory, and this is a file".into(),
         });
     }
+    Ok(())
+}
+
+/// Renders the verify sweep in `blender` and judges it.
+pub fn verify_with(blender: &Blender, v: &VerifyArgs) -> Result<(VerifyReport, Rendered), Error> {
+    check_args(v)?;
+    let seen: Vec<f64> = v.roughness.iter().map(|r| r.get()).collect();
     let explicit = v
         .coefficients
         .as_ref()
         .map(|c| Coefficients::load(c))
         .transpose()?;
-    let blender = blender_from(&v.blender, v.json)?;
     let (coefficients, source) = match (explicit, &v.coefficients) {
         (Some(c), Some(name)) => (c, name.clone()),
         _ => {
@@ -205,7 +217,7 @@ pub fn verify(v: &VerifyArgs) -> Result<(VerifyReport, Option<Rendered>), Error>
     };
     let plan = Plan::verify(&distributions, &seen, settings, true);
     let groups = GenerateParams::new(&coefficients, &source);
-    let rendered = render(&blender, &plan, &groups, v.blender.timeout, v.json)?;
+    let rendered = render(blender, &plan, &groups, v.blender.timeout, v.json)?;
 
     let masking = blender.version.masking();
     let integrator = AlbedoIntegrator::default();
@@ -244,7 +256,8 @@ pub fn verify(v: &VerifyArgs) -> Result<(VerifyReport, Option<Rendered>), Error>
     let pass = rows.iter().all(|r| r.pass);
     let mut notes = Vec::new();
     for (d, e) in &coefficients.distributions {
-        if e.masking != masking && distributions.contains(d) {
+        if e.masking != masking && e.color_space == ColorSpace::Linear && distributions.contains(d)
+        {
             notes.push(format!(
                 "{}: the coefficients were fitted for {} masking, but Blender {} uses {} masking; use --coefficients {}.",
                 d.label(), e.masking, blender.version, masking, blender.version.preset_name()
@@ -287,7 +300,7 @@ pub fn verify(v: &VerifyArgs) -> Result<(VerifyReport, Option<Rendered>), Error>
         notes,
         pass,
     };
-    Ok((report, Some(rendered)))
+    Ok((report, rendered))
 }
 
 /// The terminal table.

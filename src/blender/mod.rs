@@ -3,6 +3,7 @@
 
 pub mod discover;
 pub mod run;
+pub mod runs;
 pub mod script;
 pub mod version;
 
