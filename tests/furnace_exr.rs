@@ -141,18 +141,34 @@ fn missing_file_is_missing() {
     }
 }
 
+/// A file cut short, as a killed Blender leaves it: at half its length (the brief's case)
+/// and elsewhere, in a one-block file and in a four-block one where the first blocks are
+/// whole. The reader is not pedantic, so this checks that it does not fill the gap in.
 #[test]
 fn truncated_file_is_corrupt() {
     let dir = awkward_dir();
-    let path = good_zip_file(&dir, "half written ½.exr");
-    let bytes = std::fs::read(&path).unwrap();
-    std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
-    match read_error(&path) {
-        ExrError::Corrupt { path: p, why } => {
-            assert_eq!(p, path);
-            assert!(!why.is_empty());
+    let small = good_zip_file(&dir, "half written ½.exr");
+    let large = dir.path().join("four blocks, half written ¼.exr");
+    let channels = SpecificChannels::rgba(|p: Vec2<usize>| {
+        (p.x() as f32 / 64.0, p.y() as f32 / 64.0, 0.5f32, 1.0f32)
+    });
+    Image::from_encoded_channels((64, 64), encoding(Compression::ZIP16), channels)
+        .write()
+        .to_file(&large)
+        .unwrap();
+    for path in [small, large] {
+        let bytes = std::fs::read(&path).unwrap();
+        let n = bytes.len();
+        for cut in [n / 2, n / 4, 3 * n / 4, n - 1] {
+            std::fs::write(&path, &bytes[..cut]).unwrap();
+            match read_error(&path) {
+                ExrError::Corrupt { path: p, why } => {
+                    assert_eq!(p, path);
+                    assert!(!why.is_empty());
+                }
+                other => panic!("cut at {cut} of {n}: expected Corrupt, got {other:?}"),
+            }
         }
-        other => panic!("expected Corrupt, got {other:?}"),
     }
 }
 
@@ -231,37 +247,8 @@ fn unknown_compression_code_is_unsupported() {
 /// encodes them, which makes this fixture), so `read_rgba` returns the image — with the
 /// codec's loss in R, G and B (measured up to 2.7 % here; alpha is exact).
 /// `lossy_compression_is_unsupported` below states the stricter behaviour.
+/// A lossy file (the exr crate can decode DWAA/DWAB) is refused rather than measured.
 #[test]
-fn dwaa_and_dwab_files_read_lossily() {
-    for compression in [Compression::DWAA(None), Compression::DWAB(None)] {
-        let dir = awkward_dir();
-        let path = dir.path().join(format!("{compression} ≈.exr"));
-        write_rgba(&path, compression).expect("the exr crate writes DWA");
-        let img = read_rgba(&path).unwrap_or_else(|e| panic!("{compression}: {e}"));
-        assert_eq!((img.width, img.height), (WIDTH, HEIGHT));
-        let mut exact = true;
-        for (i, got) in img.pixels.iter().enumerate() {
-            let want = pattern(i % WIDTH, i / WIDTH);
-            assert_eq!(got[3], want[3], "{compression}: alpha of pixel {i}");
-            for c in 0..3 {
-                let error = (got[c] - want[c]).abs();
-                assert!(
-                    error <= 0.05 * want[c].abs().max(1e-3),
-                    "{compression}: pixel {i} channel {c}: {} for {}",
-                    got[c],
-                    want[c]
-                );
-                exact &= error == 0.0;
-            }
-        }
-        assert!(!exact, "{compression} came back exact; it is lossless now");
-    }
-}
-
-/// What the `Unsupported` message asks for ("32-bit float, ZIP") suggests a lossy file
-/// should be refused rather than measured; today it is read (see above).
-#[test]
-#[ignore = "read_rgba accepts lossy DWAA/DWAB; enable if it should refuse them"]
 fn lossy_compression_is_unsupported() {
     for compression in [Compression::DWAA(None), Compression::DWAB(None)] {
         let dir = awkward_dir();
@@ -342,37 +329,4 @@ fn decreasing_line_order_reads_row_0_at_the_top() {
         .to_file(&path)
         .unwrap();
     assert_pattern(&read_rgba(&path).unwrap_or_else(|e| panic!("{e}")));
-}
-
-#[test]
-fn zz_probe_offsets() {
-    let dir = awkward_dir();
-    let path = dir.path().join("big.exr");
-    let channels = SpecificChannels::rgba(|p: Vec2<usize>| {
-        (p.x() as f32 * 0.37, p.y() as f32 * 0.11, 0.5f32, 1.0f32)
-    });
-    Image::from_encoded_channels((64, 64), encoding(Compression::ZIP16), channels)
-        .write()
-        .to_file(&path)
-        .unwrap();
-    let bytes = std::fs::read(&path).unwrap();
-    let table = (0..bytes.len() - 8)
-        .find(|&p| u64::from_le_bytes(bytes[p..p + 8].try_into().unwrap()) == (p + 32) as u64)
-        .unwrap();
-    for k in 0..4 {
-        let mut b = bytes.clone();
-        for j in 0..8 { b[table + 8 * k + j] = 0; }
-        std::fs::write(&path, &b).unwrap();
-        eprintln!("zero offset {k}: {:?}", read_rgba(&path).map(|i| i.pixels[63 * 64 + 5]).map_err(|e| e.to_string()));
-    }
-    let mut b = bytes.clone();
-    for j in 0..32 { b[table + j] = 0; }
-    std::fs::write(&path, &b).unwrap();
-    eprintln!("zero all: {:?}", read_rgba(&path).map(|i| i.pixels[63 * 64 + 5]).map_err(|e| e.to_string()));
-    // zero the last chunk's data
-    let mut b = bytes.clone();
-    let last = u64::from_le_bytes(bytes[table + 24..table + 32].try_into().unwrap()) as usize;
-    for j in last + 8..b.len() { b[j] = 0; }
-    std::fs::write(&path, &b).unwrap();
-    eprintln!("zero last data: {:?}", read_rgba(&path).map(|i| i.pixels[63 * 64 + 5]).map_err(|e| e.to_string()));
 }

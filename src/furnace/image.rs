@@ -52,6 +52,14 @@ pub fn read_rgba(path: &Path) -> std::result::Result<Rgba, ExrError> {
             },
         })?;
     let layer = &image.layer_data;
+    // Lossy codecs (DWAA/DWAB, B44, PXR24) would bias a 0.1 %-level measurement: refuse them.
+    let compression = layer.encoding.compression;
+    if !compression.is_lossless_for(exr::meta::attribute::SampleType::F32) {
+        return Err(ExrError::Unsupported {
+            path: path.to_path_buf(),
+            why: format!("lossy {compression} compression"),
+        });
+    }
     let size = layer.size;
     let channels = &layer.channel_data.list;
     let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
