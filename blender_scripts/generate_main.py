@@ -31,8 +31,8 @@ def generate_main():
     built = build_all(params)  # noqa: F821 -- groups_lib.py
     saved = save_blend(options.save) if options.save else None  # noqa: F821
     names = []
-    for _spec, correction, shader in built:
-        names.extend([correction.name, shader.name])
+    for _spec, trees in built:
+        names.extend(tree.name for tree in trees)
     print(result_line({  # noqa: F821 -- groups_lib.py
         "blender_version": blender_version_string(),  # noqa: F821 -- groups_lib.py
         "groups": names,

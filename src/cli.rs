@@ -4,6 +4,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 use crate::blender::BlenderVersion;
+use crate::blender::script::Mode;
 use crate::coefficients::Target;
 use crate::fit::{Point, Weighting};
 use crate::microfacet::{Distribution, Roughness};
@@ -187,6 +188,12 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "EXISTING.blend")]
     pub into: Option<PathBuf>,
 
+    /// Which groups to build besides the roughness-only pair (repeatable): view adds
+    /// `Brightness Correction View (…)` and `Gloffuse View (…)` (gain 1/E(μ, r)), and
+    /// multiscatter adds `Gloffuse Multiscatter (…)`; both add the packed E(μ, r) table.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "roughness")]
+    pub mode: Vec<Mode>,
+
     /// With only --script: the Blender version whose preset to use by default.
     #[arg(long, default_value = "4.5", value_parser = parse_version)]
     pub blender_version: BlenderVersion,
@@ -230,6 +237,16 @@ pub struct VerifyArgs {
     /// Cycles' random seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+
+    /// Which correction to check: roughness (gain 100/f(r), judged by each sphere's mean),
+    /// view (gain 1/E(μ, r)) or multiscatter (Glossy + diffuse (1 − E)), the last two also
+    /// judged ring by ring.
+    #[arg(long, value_enum, default_value = "roughness")]
+    pub mode: Mode,
+
+    /// In the view modes: allowed |mean − 100 %| of every view-cosine ring, in percent.
+    #[arg(long, default_value_t = 1.5, value_parser = parse_tolerance)]
+    pub ring_tolerance: f64,
 
     /// Also write report.json, the rendered sweep.exr, contact-sheet.png and brightness.png here.
     #[arg(long, value_name = "DIR")]

@@ -140,7 +140,14 @@ impl Coefficients {
                     "format_version {v} is not supported; this gloffuse reads format_version {FORMAT_VERSION}"
                 )));
             }
-            None => return Err(fail("missing \"format_version\"".into())),
+            None => {
+                return Err(fail(match value.get("format_version") {
+                    None => "missing \"format_version\"".into(),
+                    Some(v) => format!(
+                        "\"format_version\" is {v}; expected the number {FORMAT_VERSION}"
+                    ),
+                }));
+            }
         }
         let c: Coefficients =
             serde_json::from_value(value).map_err(|e| fail(format!("malformed: {e}")))?;
@@ -186,10 +193,25 @@ impl Coefficients {
                 let r = i as f64 / 1000.0;
                 let f = c.percent(r);
                 if f.is_nan() || f <= 0.0 || !f.is_finite() {
+                    // Short even for absurd coefficients (1e308 prints as 309 digits).
+                    let f = if f.abs() < 1e9 {
+                        f.to_string()
+                    } else {
+                        format!("{f:.3e}")
+                    };
                     return Err(format!(
                         "{d}: f({r}) = {f}: the curve must stay above 0 on roughness [0, 1] (the gain 100/f would blow up)"
                     ));
                 }
+            }
+            if e.degree > MAX_DEGREE
+                || (c.variable == Variable::Roughness && e.degree != c.degree_in_r())
+            {
+                return Err(format!(
+                    "{d}: \"degree\" is {}, but the curve has degree {} in r (at most {MAX_DEGREE})",
+                    e.degree,
+                    c.degree_in_r()
+                ));
             }
         }
         Ok(())

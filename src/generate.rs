@@ -6,11 +6,13 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use crate::Error;
-use crate::blender::script::{GENERATE_MAIN, GenerateParams, assemble};
-use crate::blender::{Blender, BlenderVersion, FindOptions, Run, find_blender, run_script};
+use crate::blender::script::{GENERATE_MAIN, GenerateParams, Mode, assemble};
+use crate::blender::{
+    Blender, BlenderVersion, FindOptions, Run, command_line, find_blender, run_script,
+};
 use crate::cli::{BlenderArgs, GenerateArgs};
 use crate::coefficients::Coefficients;
-use crate::output::write_atomic;
+use crate::output::{check_destination, write_atomic};
 
 #[derive(Debug, Serialize)]
 pub struct Generated {
@@ -57,6 +59,53 @@ fn temp_beside(dest: &Path, suffix: &str) -> Result<tempfile::TempPath, Error> {
         })
 }
 
+/// Whether `path` opens like a .blend: `BLENDER` (uncompressed), or the gzip (before 3.0)
+/// or zstd (3.0 and later) magic of a compressed one.
+fn starts_like_blend(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 7];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| {
+            head.starts_with(b"BLENDER")
+                || head.starts_with(&[0x1f, 0x8b])
+                || head.starts_with(&[0x28, 0xb5, 0x2f, 0xfd])
+        })
+}
+
+/// Why the .blend Blender saved at `path` is unusable, if it is: missing or empty, not a
+/// .blend, or (saved uncompressed, as `save_blend` does) without the `ENDB` block that
+/// closes every complete .blend in its last 24 or 32 bytes.
+fn incomplete_blend(path: &Path) -> Option<String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let shown = path.display();
+    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if len == 0 {
+        return Some(format!("wrote no .blend ({shown} is empty)"));
+    }
+    if !starts_like_blend(path) {
+        return Some(format!(
+            "the .blend it wrote is truncated or corrupt ({shown} does not start with a .blend header)"
+        ));
+    }
+    let mut tail = vec![0u8; len.min(64) as usize];
+    let compressed = std::fs::File::open(path)
+        .and_then(|mut f| {
+            let mut head = [0u8; 7];
+            f.read_exact(&mut head)?;
+            f.seek(SeekFrom::End(-(tail.len() as i64)))?;
+            f.read_exact(&mut tail)?;
+            Ok(&head != b"BLENDER")
+        })
+        .unwrap_or(false);
+    if !compressed && !tail.windows(4).any(|w| w == b"ENDB") {
+        return Some(format!(
+            "the .blend it wrote is truncated or corrupt ({shown} lacks the ENDB block that ends a .blend)"
+        ));
+    }
+    None
+}
+
 pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
     if g.script.is_none() && g.blend.is_none() && g.into.is_none() {
         return Err(Error::input(
@@ -65,22 +114,21 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
             "--script OUT.py, --blend OUT.blend or --into EXISTING.blend",
         ));
     }
-    if let Some(into) = &g.into
-        && !into.is_file()
-    {
-        return Err(Error::input(
-            "--into",
-            &into.display().to_string(),
-            "an existing .blend file",
-        ));
-    }
-    for out in [&g.blend, &g.script].into_iter().flatten() {
-        if out.is_dir() {
-            return Err(Error::Write {
-                path: out.clone(),
-                message: "it is a directory; give a file name".into(),
-            });
+    if let Some(into) = &g.into {
+        let expected = if !into.is_file() {
+            Some("an existing .blend file")
+        } else if !starts_like_blend(into) {
+            Some("an existing .blend file (this file does not start with a .blend header)")
+        } else {
+            None
+        };
+        if let Some(expected) = expected {
+            return Err(Error::input("--into", &into.display().to_string(), expected));
         }
+    }
+    // Outputs are checked before Blender is looked for: bad input fails fast.
+    for out in [&g.blend, &g.script].into_iter().flatten() {
+        check_destination(out)?;
     }
     let needs_blender = g.blend.is_some() || g.into.is_some();
     // Coefficients are checked before Blender is looked for: bad input fails fast.
@@ -105,7 +153,10 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
             version.preset_name().to_string(),
         ),
     };
-    let params = GenerateParams::new(&coefficients, &source);
+    let mut params = GenerateParams::new(&coefficients, &source);
+    if g.mode.iter().any(|m| *m != Mode::Roughness) {
+        params = params.with_view(version.masking());
+    }
     let script = assemble(&params, GENERATE_MAIN);
     let mut out = Generated {
         blender: blender.as_ref().map(|b| b.version_string.clone()),
@@ -116,15 +167,21 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
         groups: params
             .groups
             .iter()
-            .flat_map(|s| [s.correction_group.clone(), s.shader_group.clone()])
+            .flat_map(|s| {
+                let mut names = vec![s.correction_group.clone(), s.shader_group.clone()];
+                if let Some(v) = &s.view {
+                    names.extend([v.correction_group.clone(), v.shader_group.clone(), v.multiscatter_group.clone()]);
+                }
+                names
+            })
             .collect(),
         log: None,
     };
-    if let Some(path) = &g.script {
-        write_atomic(path, script.as_bytes())?;
-        out.script = Some(path.clone());
-    }
     let Some(blender) = blender else {
+        if let Some(path) = &g.script {
+            write_atomic(path, script.as_bytes())?;
+            out.script = Some(path.clone());
+        }
         return Ok(out);
     };
 
@@ -143,19 +200,25 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
     }
     args.extend([OsString::from("--save"), tmp.to_path_buf().into_os_string()]);
     let log = run_dir.join("blender.log");
-    run_script(&Run {
+    let run = Run {
         blender: &blender,
         script: &script_path,
         args,
         timeout: Duration::from_secs(g.blender.timeout),
         log: log.clone(),
-    })?;
-    if std::fs::metadata(&tmp).map(|m| m.len()).unwrap_or(0) == 0 {
+    };
+    run_script(&run)?;
+    if let Some(why) = incomplete_blend(&tmp) {
         return Err(Error::Blender {
-            message: "Blender reported success but wrote no .blend".into(),
+            message: format!("Blender reported success but {why}"),
             log: Some(log),
-            command: None,
+            command: Some(command_line(&run)),
         });
+    }
+    // Only now, with the .blend made, the script: a failed run leaves no output at all.
+    if let Some(path) = &g.script {
+        write_atomic(path, script.as_bytes())?;
+        out.script = Some(path.clone());
     }
     if g.into.is_some() {
         // Blender's own convention: the previous version stays beside the file as .blend1.

@@ -6,8 +6,10 @@ use std::path::Path;
 
 use crate::Error;
 
-/// Writes `bytes` to `path` atomically (temporary file + rename in the same directory).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+/// Checks that `path` can be an output file: not a directory, and in a directory that
+/// exists. Commands call it before slow work (finding Blender, rendering), so that bad
+/// input fails fast; returns the directory the file goes in.
+pub fn check_destination(path: &Path) -> Result<&Path, Error> {
     let fail = |message: String| Error::Write {
         path: path.to_path_buf(),
         message,
@@ -25,6 +27,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
             dir.display()
         )));
     }
+    Ok(dir)
+}
+
+/// Writes `bytes` to `path` atomically (temporary file + rename in the same directory).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let fail = |message: String| Error::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    let dir = check_destination(path)?;
     let mut tmp = tempfile::Builder::new()
         .prefix(".gloffuse-")
         .suffix(".tmp")

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use crate::Error;
 use crate::blender::Blender;
-use crate::blender::script::GenerateParams;
+use crate::blender::script::{GenerateParams, Mode};
 use crate::cli::{BenchArgs, RefreshArgs, VerifyArgs};
 use crate::coefficients::{self, Coefficients, ColorSpace, Entry, Provenance, Target};
 use crate::fit::{Point, Variable, Weighting, fit_polynomial};
@@ -13,7 +13,7 @@ use crate::furnace::plan::{Plan, RenderSettings};
 use crate::furnace::report::VerifyReport;
 use crate::generate::blender_from;
 use crate::microfacet::{AlbedoIntegrator, Distribution, Glossy, Roughness};
-use crate::output::write_atomic;
+use crate::output::{check_destination, write_atomic};
 use crate::verify::{Rendered, render, verify_with};
 
 /// Measured and predicted brightness disagreeing by more than this (relative) is a warning.
@@ -44,12 +44,8 @@ fn grid() -> Vec<f64> {
 }
 
 pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
-    if a.out.is_dir() {
-        return Err(Error::Write {
-            path: a.out.clone(),
-            message: "it is a directory; give a file name".into(),
-        });
-    }
+    // The output is checked before Blender is looked for: bad input fails fast.
+    check_destination(&a.out)?;
     let blender = blender_from(&a.blender, a.json)?;
     let rs = grid();
     let settings = RenderSettings {
@@ -63,7 +59,7 @@ pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
         &Coefficients::load(blender.version.preset_name())?,
         blender.version.preset_name(),
     );
-    let Rendered { stats, .. } = render(&blender, &plan, &groups, a.blender.timeout, a.json)?;
+    let Rendered { stats, .. } = render(&blender, &plan, &groups, Mode::Roughness, a.blender.timeout, a.json)?;
 
     let integrator = AlbedoIntegrator::default();
     let masking = blender.version.masking();
@@ -170,6 +166,8 @@ fn verify_new(blender: &Blender, a: &RefreshArgs) -> Result<VerifyReport, Error>
         tolerance: 1.0,
         seed: 1, // not the measurement's seed: the check sees fresh noise
         report: None,
+        mode: Mode::Roughness,
+        ring_tolerance: 1.5,
         blender: a.blender.clone(),
         json: a.json,
     };
@@ -227,7 +225,7 @@ pub fn bench(b: &BenchArgs) -> Result<BenchResult, Error> {
     };
     let plan = Plan::verify(&Distribution::ALL, &rs, settings, true);
     let start = Instant::now();
-    render(&blender, &plan, &groups, b.blender.timeout, true)?;
+    render(&blender, &plan, &groups, Mode::Roughness, b.blender.timeout, true)?;
     let one = start.elapsed().as_secs_f64();
     eprintln!("one process: {} spheres in {one:.1} s", plan.cells.len());
     let start = Instant::now();
@@ -237,7 +235,7 @@ pub fn bench(b: &BenchArgs) -> Result<BenchResult, Error> {
             columns: 1,
             settings,
         };
-        render(&blender, &single, &groups, b.blender.timeout, true)?;
+        render(&blender, &single, &groups, Mode::Roughness, b.blender.timeout, true)?;
         eprint!("\rone process per sphere: {}/{}", i + 1, plan.cells.len());
     }
     eprintln!();

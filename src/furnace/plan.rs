@@ -5,7 +5,7 @@
 use serde::Serialize;
 use std::path::Path;
 
-use crate::blender::script::{GenerateParams, GroupSpec};
+use crate::blender::script::{GenerateParams, GroupSpec, Mode};
 use crate::microfacet::Distribution;
 
 /// What a sphere is shaded with.
@@ -113,13 +113,16 @@ impl Plan {
     }
 
     /// The parameter document for `furnace_main.py` (the groups plus the furnace section).
-    pub fn params(&self, groups: &GenerateParams, output: &Path) -> FurnaceParams {
-        let shader_of = |d: Distribution| -> &GroupSpec {
+    /// Corrected spheres use the shader group of `mode`.
+    pub fn params(&self, groups: &GenerateParams, mode: Mode, output: &Path) -> FurnaceParams {
+        let shader_of = |d: Distribution| -> String {
             groups
                 .groups
                 .iter()
                 .find(|g| g.distribution == d.blender_enum())
-                .expect("a corrected row only exists for distributions with a group")
+                .and_then(|g: &GroupSpec| g.shader_for(mode))
+                .expect("a corrected row only exists for distributions with a group of its mode")
+                .to_string()
         };
         let spheres = self
             .cells
@@ -134,7 +137,7 @@ impl Plan {
                     roughness: c.roughness,
                 },
                 Role::Corrected(d) => SphereSpec::Group {
-                    group: shader_of(d).shader_group.clone(),
+                    group: shader_of(d),
                     roughness: c.roughness,
                 },
             })

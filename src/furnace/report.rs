@@ -16,7 +16,10 @@ pub struct Row {
     pub predicted_uncorrected: f64,
     /// gain(r) · E_avg(r): what the coefficients should give (0–1).
     pub predicted_corrected: f64,
-    /// |corrected mean − 1| ≤ tolerance.
+    /// Largest |ring mean − 1| of the corrected sphere over its view-cosine rings.
+    pub worst_ring: f64,
+    /// |corrected mean − 1| ≤ tolerance (and, in the view modes, every ring within the ring
+    /// tolerance).
     pub pass: bool,
 }
 
@@ -45,6 +48,9 @@ pub struct RenderInfo {
 #[derive(Clone, Debug, Serialize)]
 pub struct VerifyReport {
     pub coefficients: String,
+    pub mode: crate::blender::script::Mode,
+    /// Allowed |ring mean − 100 %| in the view modes, in percent.
+    pub ring_tolerance_percent: f64,
     pub render: RenderInfo,
     /// Allowed |mean − 100 %| of a corrected sphere, in percent.
     pub tolerance_percent: f64,
