@@ -92,6 +92,8 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
     let masking = a.blender_version.masking();
     let integrator = AlbedoIntegrator::default();
     if let Some(path) = &a.table {
+        // A bad destination fails before minutes of integration, not after.
+        crate::output::check_destination(path)?;
         let n = a.grid as usize;
         let rs: Vec<f64> = (0..n).map(|j| j as f64 / (n - 1) as f64).collect();
         let mus: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
@@ -163,6 +165,9 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
 }
 
 fn fit(f: FitArgs) -> Result<i32, Error> {
+    if let Some(path) = &f.out {
+        crate::output::check_destination(path)?;
+    }
     let coefficients = if f.from.is_some() {
         if f.distribution.is_some() {
             return Err(Error::input(

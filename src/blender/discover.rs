@@ -304,6 +304,9 @@ fn probe_as(program: &Path, kind: Option<BlenderKind>, source: Source) -> Result
     } else {
         return Err(named("no such file (nor a command of that name on PATH)"));
     };
+    // Absolute (but with symlinks kept: a venv's python must stay in its venv), so the
+    // rerun command printed for a failure works from any directory.
+    let program = std::path::absolute(&program).unwrap_or(program);
     let looks_like_python = program
         .file_name()
         .is_some_and(|n| n.to_string_lossy().starts_with("python"));
