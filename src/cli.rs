@@ -17,7 +17,11 @@ far darker when rough. gloffuse measures that loss by integrating exactly the BS
 evaluates, fits correction curves f(r) (the shader gain is 100/f(r)), and writes them as \
 coefficient files for Blender node groups.
 
-Exit codes: 0 success, 1 a check failed, 2 bad input or a runtime error.";
+Exit codes: 0 success; 1 a check failed (verify, refresh); 2 an error: bad input (the message \
+names the flag or file and what would be right), no Blender found (it says where gloffuse \
+looked and how to point at one), Blender failed or timed out (the message quotes its log, \
+names the log file and prints the command to rerun it), or an output could not be written \
+(nothing half-written is ever left behind).";
 
 #[derive(Parser, Debug)]
 #[command(name = "gloffuse", version, about = ABOUT, long_about = LONG_ABOUT)]
