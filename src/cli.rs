@@ -14,8 +14,8 @@ const LONG_ABOUT: &str = "\
 Blender's single-scattering glossy BSDFs (Beckmann, GGX, Ashikhmin-Shirley) lose energy as \
 roughness grows: a white glossy sphere under a white sky should be 100 % bright but comes out \
 far darker when rough. gloffuse measures that loss by integrating exactly the BSDF Cycles \
-evaluates, fits correction curves f(r) (the shader gain is 100/f(r)), and writes them as \
-coefficient files for Blender node groups.
+evaluates, fits correction curves f(r) (the shader gain is 100/f(r)), builds Blender node groups \
+that apply them, and checks them by rendering white furnace spheres in Blender headless.
 
 Exit codes: 0 success; 1 a check failed (verify, refresh); 2 an error: bad input (the message \
 names the flag or file and what would be right), no Blender found (it says where gloffuse \

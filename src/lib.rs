@@ -5,12 +5,14 @@
 
 pub mod app;
 pub mod blender;
+pub mod brdf;
 pub mod cli;
 pub mod coefficients;
 pub mod error;
 pub mod fit;
 pub mod furnace;
 pub mod generate;
+pub mod lut;
 pub mod microfacet;
 pub mod output;
 pub mod refresh;
