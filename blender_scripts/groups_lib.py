@@ -633,7 +633,15 @@ def build_correction_group(spec, params):
 def build_shader_group(spec, params, correction_tree):
     """The group Color, Roughness, Normal -> BSDF: a Glossy BSDF whose colour
     goes through the correction group."""
-    tree = reuse_or_create_group(spec["shader_group"])
+    description = group_description(spec, params, "shader")
+    return build_glossy_group(spec["shader_group"], spec, correction_tree, description,
+                              ["gloffuse", spec["distribution"]])
+
+
+def build_glossy_group(name, spec, correction_tree, description, tags):
+    """Color, Roughness, Normal -> BSDF: a Glossy BSDF of the spec's distribution
+    whose colour goes through `correction_tree` (roughness-only or view)."""
+    tree = reuse_or_create_group(name)
     ensure_interface(tree, SHADER_SOCKETS)
     nodes, links = tree.nodes, tree.links
 
@@ -665,9 +673,8 @@ def build_shader_group(spec, params, correction_tree):
     group_out.location = (3 * COLUMN_STEP + 100.0, 0.0)
     links.new(glossy.outputs[0], group_out.inputs["BSDF"])
 
-    description = group_description(spec, params, "shader")
     set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", spec["distribution"]])
+    mark_asset(tree, description, tags)
     return tree
 
 
@@ -839,37 +846,11 @@ def build_view_correction_group(spec, params):
 
 def build_view_shader_group(spec, params, correction_tree):
     """Color, Roughness, Normal -> BSDF: Glossy with colour x 1 / E(mu, r)."""
-    view = spec["view"]
-    tree = reuse_or_create_group(view["shader_group"])
-    ensure_interface(tree, SHADER_SOCKETS)
-    nodes, links = tree.nodes, tree.links
-    group_in = nodes.new("NodeGroupInput")
-    group_in.location = (0.0, 0.0)
-    correction = nodes.new("ShaderNodeGroup")
-    correction.node_tree = correction_tree
-    correction.name = "Brightness correction"
-    correction.label = short_label(correction_tree.name)
-    correction.width = 260.0
-    correction.location = (COLUMN_STEP + 20.0, 160.0)
-    links.new(group_in.outputs["Roughness"], correction.inputs["Roughness"])
-    links.new(group_in.outputs["Color"], correction.inputs["Color"])
-    glossy = glossy_node(nodes, spec["distribution"])
-    glossy.name = "Glossy BSDF"
-    glossy.label = short_label("Glossy BSDF (%s)" % spec["distribution"])
-    glossy.width = NODE_WIDTH
-    glossy.location = (2 * COLUMN_STEP + 100.0, 0.0)
-    links.new(correction.outputs["Color"], glossy.inputs["Color"])
-    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
-    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (3 * COLUMN_STEP + 100.0, 0.0)
-    links.new(glossy.outputs[0], group_out.inputs["BSDF"])
     description = view_description(spec, params, (
         "Glossy BSDF (%s) whose colour is multiplied by the view-dependent gain of '%s'."
         % (spec["distribution"], correction_tree.name)))
-    set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", spec["distribution"], "view"])
-    return tree
+    return build_glossy_group(spec["view"]["shader_group"], spec, correction_tree, description,
+                              ["gloffuse", spec["distribution"], "view"])
 
 
 def build_multiscatter_group(spec, params):
