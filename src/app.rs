@@ -89,6 +89,10 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
 }
 
 fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
+    if let Some(model) = a.model {
+        return model_albedo(&a, model);
+    }
+    let distribution = a.distribution.expect("clap requires --distribution without --model");
     let masking = a.blender_version.masking();
     let integrator = AlbedoIntegrator::default();
     if let Some(path) = &a.table {
@@ -98,7 +102,7 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
         let rs: Vec<f64> = (0..n).map(|j| j as f64 / (n - 1) as f64).collect();
         let mus: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
         let make = |r: f64| Glossy {
-            distribution: a.distribution,
+            distribution,
             masking,
             alpha: r * r,
         };
@@ -126,12 +130,12 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
             "--roughness R (0 to 1), or --table FILE for a grid",
         )
     })?;
-    let g = Glossy::new(a.distribution, masking, roughness);
+    let g = Glossy::new(distribution, masking, roughness);
     let e = integrator.directional_albedo(&g, a.mu);
     let avg = integrator.average_albedo(&g);
     if a.json {
         let v = json!({
-            "distribution": a.distribution,
+            "distribution": distribution,
             "roughness": roughness.get(),
             "alpha": roughness.alpha(),
             "mu": a.mu,
@@ -144,7 +148,7 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
     } else {
         println!(
             "{} roughness {} (alpha {}), Blender {} ({} masking)",
-            a.distribution.label(),
+            distribution.label(),
             roughness.get(),
             roughness.alpha(),
             a.blender_version,
@@ -417,6 +421,41 @@ fn show(source: Option<String>, json: bool) -> Result<i32, Error> {
     println!("{} — {}", c.name, c.description);
     for (d, e) in &c.distributions {
         print!("{}", describe_entry(d.label(), e));
+    }
+    Ok(0)
+}
+
+/// `albedo --model`: directional albedo of a classic BRDF, and its hemispherical average.
+fn model_albedo(a: &AlbedoArgs, model: crate::brdf::Model) -> Result<i32, Error> {
+    let params = crate::brdf::ModelParams {
+        rho: a.rho,
+        rs: a.rs,
+        exponent: a.exponent,
+        alpha_x: a.alpha_x,
+        alpha_y: a.alpha_y,
+    };
+    let e = crate::brdf::model_albedo(model, &params, a.mu)?;
+    // E_avg = 2∫E(μ)μdμ by a 16-point midpoint rule in μ².
+    let n = 16;
+    let avg = (0..n)
+        .map(|i| {
+            let mu = ((i as f64 + 0.5) / n as f64).sqrt();
+            crate::brdf::model_albedo(model, &params, mu).map(|e| e / n as f64)
+        })
+        .sum::<Result<f64, Error>>()?;
+    if a.json {
+        let v = json!({
+            "model": format!("{model:?}"),
+            "parameters": { "rho": a.rho, "rs": a.rs, "exponent": a.exponent, "alpha_x": a.alpha_x, "alpha_y": a.alpha_y },
+            "mu": a.mu,
+            "directional_albedo": e,
+            "average_albedo": avg,
+        });
+        println!("{}", serde_json::to_string_pretty(&v).expect("json"));
+    } else {
+        println!("{model:?} (rho {}, rs {}, exponent {}, alpha {} × {})", a.rho, a.rs, a.exponent, a.alpha_x, a.alpha_y);
+        println!("E(mu = {}) = {e:.6}", a.mu);
+        println!("E_avg      = {avg:.6}");
     }
     Ok(0)
 }

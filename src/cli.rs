@@ -79,8 +79,34 @@ pub enum Command {
 #[derive(Args, Debug)]
 pub struct AlbedoArgs {
     /// beckmann, ggx or ashikhmin-shirley (case-insensitive; BECKMANN, GGX, ASHIKHMIN_SHIRLEY work too).
-    #[arg(long, short = 'd', value_parser = parse_distribution)]
-    pub distribution: Distribution,
+    #[arg(long, short = 'd', value_parser = parse_distribution, required_unless_present = "model")]
+    pub distribution: Option<Distribution>,
+
+    /// A classic BRDF instead of Blender's Glossy: lambert, phong (normalised modified Phong),
+    /// ward (anisotropic), cook-torrance (Beckmann D, Schlick Fresnel), fresnel-blend
+    /// (Ashikhmin–Shirley's diffuse term). Parameters: --rho, --rs, --exponent, --alpha-x, --alpha-y.
+    #[arg(long, value_parser = parse_model, conflicts_with_all = ["distribution", "roughness", "table"])]
+    pub model: Option<crate::brdf::Model>,
+
+    /// --model: reflectance ρ (Lambert), ρs (Phong, Ward), f0 (Cook–Torrance) or Rd (Fresnel blend).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub rho: f64,
+
+    /// --model fresnel-blend: specular reflectance Rs at normal incidence.
+    #[arg(long, default_value_t = 0.04, allow_hyphen_values = true)]
+    pub rs: f64,
+
+    /// --model phong: the exponent n.
+    #[arg(long, default_value_t = 32.0, allow_hyphen_values = true)]
+    pub exponent: f64,
+
+    /// --model ward: αx (along the tangent); --model cook-torrance: α.
+    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
+    pub alpha_x: f64,
+
+    /// --model ward: αy (along the bitangent).
+    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
+    pub alpha_y: f64,
 
     /// The Glossy node's Roughness, 0 to 1 (Cycles uses alpha = r²).
     #[arg(long, short = 'r', value_parser = parse_roughness, allow_hyphen_values = true)]
@@ -332,6 +358,10 @@ pub enum CoefficientsCommand {
 }
 
 fn parse_distribution(s: &str) -> Result<Distribution, String> {
+    s.parse().map_err(|e: crate::Error| e.to_string())
+}
+
+fn parse_model(s: &str) -> Result<crate::brdf::Model, String> {
     s.parse().map_err(|e: crate::Error| e.to_string())
 }
 

@@ -352,3 +352,28 @@ fn malformed_coefficient_files_are_refused() {
             );
     }
 }
+
+#[test]
+fn albedo_of_classic_models_matches_closed_forms() {
+    let v = json_of(&["albedo", "--model", "lambert", "--rho", "0.7", "--mu", "0.3", "--json"]);
+    assert!((v["directional_albedo"].as_f64().unwrap() - 0.7).abs() < 1e-3);
+    // Fresnel blend: E(μ) = Rd (1 − Rs)(1 − (1 − μ/2)⁵).
+    let v = json_of(&["albedo", "--model", "fresnel-blend", "--rho", "1", "--rs", "0.04", "--json"]);
+    let want = 0.96 * (1.0 - 0.5f64.powi(5));
+    assert!((v["directional_albedo"].as_f64().unwrap() - want).abs() < 1e-3);
+    for m in ["phong", "ward", "cook-torrance"] {
+        let v = json_of(&["albedo", "--model", m, "--mu", "0.5", "--json"]);
+        let e = v["directional_albedo"].as_f64().unwrap();
+        assert!(e > 0.0 && e <= 1.0 + 1e-9, "{m}: {e}");
+    }
+    gloffuse()
+        .args(["albedo", "--model", "lambert", "--rho", "2"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("reflectance rho '2'"));
+    gloffuse()
+        .args(["albedo", "--model", "blinn"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("blinn"));
+}
