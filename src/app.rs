@@ -74,6 +74,15 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
                 _ => 0,
             })
         }
+        Command::Lut(l) => {
+            let summary = crate::lut::lut(&l)?;
+            if l.json {
+                println!("{}", serde_json::to_string_pretty(&summary).expect("json"));
+            } else {
+                print!("{}", crate::lut::describe(&summary));
+            }
+            Ok(0)
+        }
         Command::Bench(b) => {
             let r = crate::refresh::bench(&b)?;
             println!(
@@ -92,7 +101,9 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
     if let Some(model) = a.model {
         return model_albedo(&a, model);
     }
-    let distribution = a.distribution.expect("clap requires --distribution without --model");
+    let distribution = a
+        .distribution
+        .expect("clap requires --distribution without --model");
     let masking = a.blender_version.masking();
     let integrator = AlbedoIntegrator::default();
     if let Some(path) = &a.table {
@@ -453,7 +464,10 @@ fn model_albedo(a: &AlbedoArgs, model: crate::brdf::Model) -> Result<i32, Error>
         });
         println!("{}", serde_json::to_string_pretty(&v).expect("json"));
     } else {
-        println!("{model:?} (rho {}, rs {}, exponent {}, alpha {} × {})", a.rho, a.rs, a.exponent, a.alpha_x, a.alpha_y);
+        println!(
+            "{model:?} (rho {}, rs {}, exponent {}, alpha {} × {})",
+            a.rho, a.rs, a.exponent, a.alpha_x, a.alpha_y
+        );
         println!("E(mu = {}) = {e:.6}", a.mu);
         println!("E_avg      = {avg:.6}");
     }

@@ -67,6 +67,14 @@ pub enum Command {
     /// integrator's prediction (a disagreement above 0.5 % is a warning), and runs `verify`
     /// with the new file.
     Refresh(RefreshArgs),
+    /// Write a lookup table for real-time renderers: the split-sum LUT or Kulla–Conty's.
+    ///
+    /// split-sum: the GGX "BRDF generator" texture (R = scale, G = bias; specular =
+    /// F0·scale + bias). kulla-conty: for the Glossy BSDF Cycles evaluates, scale, bias,
+    /// the missing multiple-scattering energy ∫f_ms cos and E_avg (RGBA), so a renderer can
+    /// add back what single scattering loses. Texel (x, y) holds roughness (x + ½)/n and
+    /// N·V = (y + ½)/n, first row first; written as EXR, DDS (DX10) or KTX 2.0, half or float.
+    Lut(crate::lut::LutArgs),
     /// Time the verify sweep as one Blender process against one process per sphere.
     Bench(BenchArgs),
     /// Inspect coefficient files and the built-in presets.
@@ -357,7 +365,7 @@ pub enum CoefficientsCommand {
     },
 }
 
-fn parse_distribution(s: &str) -> Result<Distribution, String> {
+pub(crate) fn parse_distribution(s: &str) -> Result<Distribution, String> {
     s.parse().map_err(|e: crate::Error| e.to_string())
 }
 
@@ -369,7 +377,7 @@ fn parse_roughness(s: &str) -> Result<Roughness, String> {
     s.parse().map_err(|e: crate::Error| e.to_string())
 }
 
-fn parse_version(s: &str) -> Result<BlenderVersion, String> {
+pub(crate) fn parse_version(s: &str) -> Result<BlenderVersion, String> {
     s.parse().map_err(|e: crate::Error| e.to_string())
 }
 

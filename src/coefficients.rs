@@ -143,9 +143,9 @@ impl Coefficients {
             None => {
                 return Err(fail(match value.get("format_version") {
                     None => "missing \"format_version\"".into(),
-                    Some(v) => format!(
-                        "\"format_version\" is {v}; expected the number {FORMAT_VERSION}"
-                    ),
+                    Some(v) => {
+                        format!("\"format_version\" is {v}; expected the number {FORMAT_VERSION}")
+                    }
                 }));
             }
         }

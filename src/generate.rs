@@ -123,7 +123,11 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
             None
         };
         if let Some(expected) = expected {
-            return Err(Error::input("--into", &into.display().to_string(), expected));
+            return Err(Error::input(
+                "--into",
+                &into.display().to_string(),
+                expected,
+            ));
         }
     }
     // Outputs are checked before Blender is looked for: bad input fails fast.
@@ -170,7 +174,11 @@ pub fn generate(g: &GenerateArgs) -> Result<Generated, Error> {
             .flat_map(|s| {
                 let mut names = vec![s.correction_group.clone(), s.shader_group.clone()];
                 if let Some(v) = &s.view {
-                    names.extend([v.correction_group.clone(), v.shader_group.clone(), v.multiscatter_group.clone()]);
+                    names.extend([
+                        v.correction_group.clone(),
+                        v.shader_group.clone(),
+                        v.multiscatter_group.clone(),
+                    ]);
                 }
                 names
             })

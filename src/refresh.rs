@@ -59,7 +59,14 @@ pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
         &Coefficients::load(blender.version.preset_name())?,
         blender.version.preset_name(),
     );
-    let Rendered { stats, .. } = render(&blender, &plan, &groups, Mode::Roughness, a.blender.timeout, a.json)?;
+    let Rendered { stats, .. } = render(
+        &blender,
+        &plan,
+        &groups,
+        Mode::Roughness,
+        a.blender.timeout,
+        a.json,
+    )?;
 
     let integrator = AlbedoIntegrator::default();
     let masking = blender.version.masking();
@@ -225,7 +232,14 @@ pub fn bench(b: &BenchArgs) -> Result<BenchResult, Error> {
     };
     let plan = Plan::verify(&Distribution::ALL, &rs, settings, true);
     let start = Instant::now();
-    render(&blender, &plan, &groups, Mode::Roughness, b.blender.timeout, true)?;
+    render(
+        &blender,
+        &plan,
+        &groups,
+        Mode::Roughness,
+        b.blender.timeout,
+        true,
+    )?;
     let one = start.elapsed().as_secs_f64();
     eprintln!("one process: {} spheres in {one:.1} s", plan.cells.len());
     let start = Instant::now();
@@ -235,7 +249,14 @@ pub fn bench(b: &BenchArgs) -> Result<BenchResult, Error> {
             columns: 1,
             settings,
         };
-        render(&blender, &single, &groups, Mode::Roughness, b.blender.timeout, true)?;
+        render(
+            &blender,
+            &single,
+            &groups,
+            Mode::Roughness,
+            b.blender.timeout,
+            true,
+        )?;
         eprint!("\rone process per sphere: {}/{}", i + 1, plan.cells.len());
     }
     eprintln!();

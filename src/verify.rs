@@ -399,7 +399,10 @@ pub fn table(report: &VerifyReport) -> String {
     let failed = report.rows.iter().filter(|r| !r.pass).count();
     let rings = match report.mode {
         Mode::Roughness => String::new(),
-        _ => format!(", every view-cosine ring within ±{} %", report.ring_tolerance_percent),
+        _ => format!(
+            ", every view-cosine ring within ±{} %",
+            report.ring_tolerance_percent
+        ),
     };
     let _ = writeln!(
         s,

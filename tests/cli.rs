@@ -355,10 +355,21 @@ fn malformed_coefficient_files_are_refused() {
 
 #[test]
 fn albedo_of_classic_models_matches_closed_forms() {
-    let v = json_of(&["albedo", "--model", "lambert", "--rho", "0.7", "--mu", "0.3", "--json"]);
+    let v = json_of(&[
+        "albedo", "--model", "lambert", "--rho", "0.7", "--mu", "0.3", "--json",
+    ]);
     assert!((v["directional_albedo"].as_f64().unwrap() - 0.7).abs() < 1e-3);
     // Fresnel blend: E(μ) = Rd (1 − Rs)(1 − (1 − μ/2)⁵).
-    let v = json_of(&["albedo", "--model", "fresnel-blend", "--rho", "1", "--rs", "0.04", "--json"]);
+    let v = json_of(&[
+        "albedo",
+        "--model",
+        "fresnel-blend",
+        "--rho",
+        "1",
+        "--rs",
+        "0.04",
+        "--json",
+    ]);
     let want = 0.96 * (1.0 - 0.5f64.powi(5));
     assert!((v["directional_albedo"].as_f64().unwrap() - want).abs() < 1e-3);
     for m in ["phong", "ward", "cook-torrance"] {
@@ -376,4 +387,117 @@ fn albedo_of_classic_models_matches_closed_forms() {
         .assert()
         .code(2)
         .stderr(predicate::str::contains("blinn"));
+}
+
+/// `lut` end to end: the file the binary writes is what its summary says, and a texel of
+/// the Kulla–Conty table (Monte Carlo over Cycles' BSDF) agrees with `albedo` (deterministic
+/// quadrature) — two independent estimators of the same E(μ, r).
+#[test]
+fn lut_writes_the_table_its_summary_describes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("kc.exr");
+    let p = path.to_str().unwrap();
+    let summary = json_of(&[
+        "lut",
+        "--kind",
+        "kulla-conty",
+        "-d",
+        "ggx",
+        "--size",
+        "16",
+        "--bits",
+        "32",
+        "--out",
+        p,
+        "--json",
+    ]);
+    assert_eq!(summary["width"], 16);
+    assert_eq!(summary["channels"].as_array().unwrap().len(), 4);
+    assert_eq!(
+        summary["bytes"].as_u64().unwrap(),
+        std::fs::metadata(&path).unwrap().len()
+    );
+
+    let image = exr::prelude::read_first_flat_layer_from_file(&path).unwrap();
+    let layer = &image.layer_data;
+    let channel = |name: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("no channel {name}"))
+    };
+    let (x, y) = (8usize, 12usize); // r = 8.5/16, μ = 12.5/16
+    let at = |name: &str| {
+        channel(name)
+            .sample_data
+            .value_by_flat_index(y * 16 + x)
+            .to_f32() as f64
+    };
+    let (r, mu) = (8.5 / 16.0, 12.5 / 16.0);
+    let albedo = json_of(&[
+        "albedo",
+        "-d",
+        "ggx",
+        "-r",
+        &r.to_string(),
+        "--mu",
+        &mu.to_string(),
+        "--json",
+    ]);
+    let e = albedo["directional_albedo"].as_f64().unwrap();
+    let e_avg = albedo["average_albedo"].as_f64().unwrap();
+    assert!(
+        (at("R") + at("G") - e).abs() < 5e-4,
+        "R+G {} vs E {e}",
+        at("R") + at("G")
+    );
+    assert!(
+        (at("A") - e_avg).abs() < 2e-3,
+        "A {} vs E_avg {e_avg}",
+        at("A")
+    );
+    assert!(at("B") > 0.0 && at("B") < 1.0 - e + 0.01);
+
+    // The human summary names the file and the layout.
+    gloffuse()
+        .args([
+            "lut",
+            "--size",
+            "8",
+            "--out",
+            dir.path().join("s.dds").to_str().unwrap(),
+        ])
+        .assert()
+        .success()
+        .stdout(
+            predicate::str::contains("DXGI_FORMAT_R16G16_FLOAT")
+                .and(predicate::str::contains("uv = (roughness, N·V)")),
+        );
+}
+
+#[test]
+fn lut_bad_input_exits_2_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--out", "t.png"], "--out"),
+        (&["--size", "0", "--out", "t.exr"], "--size"),
+        (
+            &["--kind", "split-sum", "-d", "beckmann", "--out", "t.exr"],
+            "--distribution",
+        ),
+        (&["--bits", "8", "--out", "t.exr"], "--bits"),
+        (&["--out", "missing/t.exr"], "missing"),
+    ];
+    for (args, named) in cases {
+        gloffuse()
+            .current_dir(dir.path())
+            .arg("lut")
+            .args(*args)
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(*named));
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }

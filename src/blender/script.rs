@@ -46,10 +46,24 @@ impl AlbedoTable {
         let integrator = AlbedoIntegrator::default();
         let rs: Vec<f64> = (0..size).map(|j| j as f64 / (size - 1) as f64).collect();
         // μ = 0 is a limit; the bottom row uses a grazing view instead.
-        let mus: Vec<f64> = (0..size).map(|i| (i as f64 / (size - 1) as f64).max(1e-3)).collect();
-        let make = |r: f64| Glossy { distribution, masking, alpha: r * r };
-        let values = integrator.table(make, &mus, &rs).into_iter().map(|e| e as f32).collect();
-        AlbedoTable { width: size, height: size, values }
+        let mus: Vec<f64> = (0..size)
+            .map(|i| (i as f64 / (size - 1) as f64).max(1e-3))
+            .collect();
+        let make = |r: f64| Glossy {
+            distribution,
+            masking,
+            alpha: r * r,
+        };
+        let values = integrator
+            .table(make, &mus, &rs)
+            .into_iter()
+            .map(|e| e as f32)
+            .collect();
+        AlbedoTable {
+            width: size,
+            height: size,
+            values,
+        }
     }
 }
 

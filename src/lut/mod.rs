@@ -1,0 +1,557 @@
+//! Lookup tables for real-time renderers (DESIGN.md §5): the split-sum LUT and the
+//! Kulla–Conty energy-compensation LUT, written as EXR, DDS or KTX2 textures.
+//!
+//! # Layout (every kind, every format)
+//!
+//! An n × n texture, row-major, **first row first**: texel (x, y) holds roughness
+//! `r = (x + ½)/n` and view cosine `N·V = (y + ½)/n` (pixel centres), so a shader samples
+//! it at `uv = (roughness, N·V)` with the file's rows uploaded in order (row 0 at v = 0, the
+//! top of the image in an EXR viewer). Values are linear floats (16-bit half or 32-bit).
+//!
+//! # Kinds
+//!
+//! * [`Kind::SplitSum`], 2 channels: **R = scale, G = bias**, the classic GGX "BRDF
+//!   generator" (see [`split_sum`]); at run time `specular = F0 · scale + bias`. By default
+//!   sampled with GGX's visible normals at 2048 samples: 512² in about 0.37 s (ue4) /
+//!   0.45 s (height-correlated) on 2 cores, within 7.2e-4 of the converged table
+//!   (`cargo bench --bench lut`); `--sampling classic` is DESIGN.md §5 verbatim (1e-2 off
+//!   near grazing at 1024 samples).
+//! * [`Kind::KullaConty`], 4 channels, for the Glossy BSDF that Cycles evaluates (chosen by
+//!   `--distribution` and `--blender-version`; see [`kulla_conty`]):
+//!   **R = scale, G = bias** (the same split-sum pair, integrated over Cycles' BSDF, so
+//!   `R + G ≈ E(μ, r)`), **B = ∫ f_ms(μ, μi) cosθi dωi** (the multiple-scattering lobe
+//!   `f_ms = (1 − E(μ))(1 − E(μi)) / (π (1 − E_avg))`, integrated in closed form; it is
+//!   `≈ 1 − E(μ)`), and **A = E_avg(r)** (constant along each column) for the Fresnel term
+//!   `F_avg E_avg / (1 − F_avg (1 − E_avg))` that scales B under a coloured Fresnel.
+//!   `E(μ, r)` itself (Cycles-exact, from [`crate::microfacet::AlbedoIntegrator`]) is in
+//!   [`kulla_conty::KullaConty::e`].
+//!
+//! # Formats
+//!
+//! * EXR (`exr` crate): one part, scan lines, ZIP compression (16 lines), channels R, G
+//!   [, B, A] as half or float.
+//! * DDS (`ddsfile` crate): DX10 header, DXGI_FORMAT_R16G16_FLOAT / R32G32_FLOAT (split-sum)
+//!   or R16G16B16A16_FLOAT / R32G32B32A32_FLOAT (Kulla–Conty), one mip level.
+//! * KTX 2.0 (written here, see [`ktx2`]): VK_FORMAT_R16G16_SFLOAT / R32G32_SFLOAT or
+//!   R16G16B16A16_SFLOAT / R32G32B32A32_SFLOAT, one level, no supercompression.
+
+pub mod dds;
+pub mod ktx2;
+pub mod kulla_conty;
+pub mod openexr;
+pub mod split_sum;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::Error;
+use crate::blender::BlenderVersion;
+use crate::microfacet::Distribution;
+
+/// The largest `--size` accepted: 8192² texels of RGBA32F is already 1 GiB.
+pub const MAX_SIZE: u32 = 8192;
+/// The largest `--samples` accepted per texel.
+pub const MAX_SAMPLES: u32 = 1 << 20;
+
+/// Which table to compute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Kind {
+    /// GGX split-sum (R = scale, G = bias).
+    SplitSum,
+    /// Kulla–Conty for a Cycles Glossy BSDF (R = scale, G = bias, B = ∫f_ms cos, A = E_avg).
+    KullaConty,
+}
+
+impl Kind {
+    pub fn key(self) -> &'static str {
+        match self {
+            Kind::SplitSum => "split-sum",
+            Kind::KullaConty => "kulla-conty",
+        }
+    }
+}
+
+/// The masking–shadowing term of the split-sum table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GModel {
+    /// Separable Schlick-GGX with k = α/2 (Karis' UE4 table).
+    Ue4,
+    /// Smith GGX height-correlated, G2 = 1/(1 + Λ(V) + Λ(L)) (Cycles 3.6+, Filament).
+    HeightCorrelated,
+}
+
+impl GModel {
+    pub fn key(self) -> &'static str {
+        match self {
+            GModel::Ue4 => "ue4",
+            GModel::HeightCorrelated => "height-correlated",
+        }
+    }
+}
+
+/// How the split-sum integral is sampled (both estimate the same integral; see
+/// [`split_sum`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sampling {
+    /// GGX visible normals (Heitz 2018): bounded weights, 1e-3 at 2048 samples.
+    VisibleNormals,
+    /// DESIGN.md §5 / UE4 to the letter: H ~ D·N·H; up to 1e-2 off near grazing at 1024.
+    Classic,
+}
+
+impl Sampling {
+    pub fn key(self) -> &'static str {
+        match self {
+            Sampling::VisibleNormals => "visible-normals",
+            Sampling::Classic => "classic",
+        }
+    }
+}
+
+/// The container written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Format {
+    /// OpenEXR, ZIP-compressed scan lines.
+    Exr,
+    /// DirectDraw Surface with a DX10 header.
+    Dds,
+    /// KTX 2.0 (not KTX 1).
+    #[value(alias = "ktx2")]
+    #[serde(rename = "ktx2")]
+    Ktx,
+}
+
+impl Format {
+    /// The format a file name's extension implies: `.exr`, `.dds`, `.ktx2` / `.ktx`.
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "exr" => Some(Format::Exr),
+            "dds" => Some(Format::Dds),
+            "ktx2" | "ktx" => Some(Format::Ktx),
+            _ => None,
+        }
+    }
+
+    pub fn key(self) -> &'static str {
+        match self {
+            Format::Exr => "exr",
+            Format::Dds => "dds",
+            Format::Ktx => "ktx2",
+        }
+    }
+}
+
+/// Bits per channel of the stored floats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum Bits {
+    /// IEEE half floats (what GPUs sample fastest; rounding error ≤ 2.5e-4 below 1).
+    #[value(name = "16")]
+    #[serde(rename = "16")]
+    Half,
+    /// IEEE single floats (exactly the computed values).
+    #[value(name = "32")]
+    #[serde(rename = "32")]
+    Float,
+}
+
+impl Bits {
+    pub fn count(self) -> u32 {
+        match self {
+            Bits::Half => 16,
+            Bits::Float => 32,
+        }
+    }
+}
+
+/// `gloffuse lut`: write a split-sum or Kulla–Conty lookup table as EXR, DDS or KTX2.
+///
+/// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
+#[derive(clap::Args, Debug, Clone, PartialEq)]
+pub struct LutArgs {
+    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA).
+    #[arg(long, value_enum, default_value_t = Kind::SplitSum)]
+    pub kind: Kind,
+
+    /// kulla-conty only: beckmann, ggx or ashikhmin-shirley [default: ggx].
+    #[arg(long, short = 'd', value_parser = crate::cli::parse_distribution)]
+    pub distribution: Option<Distribution>,
+
+    /// kulla-conty only: the Blender whose masking the BSDF follows (3.x separable, 3.6+ height-correlated) [default: 4.5].
+    #[arg(long, value_parser = crate::cli::parse_version)]
+    pub blender_version: Option<BlenderVersion>,
+
+    /// Texels per side, 1 to 8192 [default: 512 for split-sum, 64 for kulla-conty].
+    #[arg(long, value_name = "N")]
+    pub size: Option<u32>,
+
+    /// Hammersley samples per texel, 1 to 1048576 [default: 2048 split-sum (max error 7e-4), 4096 kulla-conty].
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u32>,
+
+    /// split-sum only: visible-normals (accurate) or classic (DESIGN.md §5 / UE4 verbatim) [default: visible-normals].
+    #[arg(long, value_enum)]
+    pub sampling: Option<Sampling>,
+
+    /// Bits per channel: 16 (half float) or 32 (float).
+    #[arg(long, value_enum, default_value_t = Bits::Half)]
+    pub bits: Bits,
+
+    /// split-sum only: ue4 (Schlick-GGX, k = α/2) or height-correlated (Smith GGX) [default: ue4].
+    #[arg(long, value_enum)]
+    pub g_model: Option<GModel>,
+
+    /// exr, dds or ktx (KTX 2.0) [default: from the --out extension: .exr, .dds, .ktx2/.ktx].
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
+
+    /// The file to write (atomically: it appears complete or not at all).
+    #[arg(long, short = 'o', value_name = "FILE")]
+    pub out: PathBuf,
+
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl LutArgs {
+    /// Arguments with every default, writing to `out`.
+    pub fn new(kind: Kind, out: impl Into<PathBuf>) -> Self {
+        LutArgs {
+            kind,
+            distribution: None,
+            blender_version: None,
+            size: None,
+            samples: None,
+            sampling: None,
+            bits: Bits::Half,
+            g_model: None,
+            format: None,
+            out: out.into(),
+            json: false,
+        }
+    }
+}
+
+/// A computed table: `width × height` texels, row-major, `channels.len()` interleaved f32
+/// values per texel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    pub width: usize,
+    pub height: usize,
+    /// Channel names as stored: `R`, `G`[, `B`, `A`].
+    pub channels: &'static [&'static str],
+    pub data: Vec<f32>,
+}
+
+impl Table {
+    /// Texel (x, y), channel c.
+    pub fn get(&self, x: usize, y: usize, c: usize) -> f32 {
+        self.data[(y * self.width + x) * self.channels.len() + c]
+    }
+
+    /// The texels as a GPU uploads them: row-major, channels interleaved, little-endian
+    /// IEEE half (rounded to nearest even) or single floats.
+    pub fn texel_bytes(&self, bits: Bits) -> Vec<u8> {
+        match bits {
+            Bits::Half => self
+                .data
+                .iter()
+                .flat_map(|&v| half::f16::from_f32(v).to_le_bytes())
+                .collect(),
+            Bits::Float => self.data.iter().flat_map(|&v| v.to_le_bytes()).collect(),
+        }
+    }
+}
+
+/// What a validated request computes (parse, don't validate: built once from [`LutArgs`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Spec {
+    SplitSum {
+        size: usize,
+        samples: u32,
+        g_model: GModel,
+        sampling: Sampling,
+    },
+    KullaConty {
+        size: usize,
+        samples: u32,
+        distribution: Distribution,
+        blender_version: BlenderVersion,
+    },
+}
+
+impl Spec {
+    /// Checks the numbers and the flag combinations; errors name the flag.
+    pub fn from_args(args: &LutArgs) -> Result<Spec, Error> {
+        let (default_size, default_samples) = match args.kind {
+            Kind::SplitSum => (512, 2048),
+            Kind::KullaConty => (64, 4096),
+        };
+        let size = args.size.unwrap_or(default_size);
+        let samples = args.samples.unwrap_or(default_samples);
+        if size == 0 || size > MAX_SIZE {
+            return Err(Error::input(
+                "--size",
+                &size.to_string(),
+                &format!("texels per side from 1 to {MAX_SIZE}"),
+            ));
+        }
+        if samples == 0 || samples > MAX_SAMPLES {
+            return Err(Error::input(
+                "--samples",
+                &samples.to_string(),
+                &format!("samples per texel from 1 to {MAX_SAMPLES}"),
+            ));
+        }
+        let size = size as usize;
+        match args.kind {
+            Kind::SplitSum => {
+                if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
+                    return Err(Error::input(
+                        "--distribution",
+                        d.key(),
+                        "ggx or nothing: the split-sum table is GGX by definition (use --kind kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
+                    ));
+                }
+                if let Some(v) = args.blender_version {
+                    return Err(Error::input(
+                        "--blender-version",
+                        &v.to_string(),
+                        "nothing with --kind split-sum (choose its masking with --g-model; --blender-version applies to kulla-conty)",
+                    ));
+                }
+                Ok(Spec::SplitSum {
+                    size,
+                    samples,
+                    g_model: args.g_model.unwrap_or(GModel::Ue4),
+                    sampling: args.sampling.unwrap_or(Sampling::VisibleNormals),
+                })
+            }
+            Kind::KullaConty => {
+                if let Some(g) = args.g_model {
+                    return Err(Error::input(
+                        "--g-model",
+                        g.key(),
+                        "nothing with --kind kulla-conty (its masking follows --blender-version; --g-model applies to split-sum)",
+                    ));
+                }
+                if let Some(s) = args.sampling {
+                    return Err(Error::input(
+                        "--sampling",
+                        s.key(),
+                        "nothing with --kind kulla-conty (it samples each distribution's own D·cosθh; --sampling applies to split-sum)",
+                    ));
+                }
+                Ok(Spec::KullaConty {
+                    size,
+                    samples,
+                    distribution: args.distribution.unwrap_or(Distribution::Ggx),
+                    blender_version: args
+                        .blender_version
+                        .unwrap_or(BlenderVersion { major: 4, minor: 5 }),
+                })
+            }
+        }
+    }
+
+    /// Computes the table.
+    pub fn compute(&self) -> Table {
+        match *self {
+            Spec::SplitSum {
+                size,
+                samples,
+                g_model,
+                sampling,
+            } => Table {
+                width: size,
+                height: size,
+                channels: &["R", "G"],
+                data: split_sum::split_sum(size, samples, g_model, sampling),
+            },
+            Spec::KullaConty {
+                size,
+                samples,
+                distribution,
+                blender_version,
+            } => kulla_conty::kulla_conty(size, samples, distribution, blender_version.masking())
+                .table(),
+        }
+    }
+}
+
+/// Encodes a table in memory as a file of the given format and bit depth (an error is the
+/// encoder's message; it does not happen for tables that [`Spec::compute`] makes).
+pub fn encode(table: &Table, format: Format, bits: Bits) -> Result<Vec<u8>, String> {
+    match format {
+        Format::Exr => openexr::encode(table, bits),
+        Format::Dds => dds::encode(table, bits),
+        Format::Ktx => Ok(ktx2::encode(table, bits)),
+    }
+}
+
+/// What [`lut`] wrote.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LutSummary {
+    pub path: PathBuf,
+    pub kind: Kind,
+    pub format: Format,
+    /// The GPU format name: `VK_FORMAT_…` (KTX2), `DXGI_FORMAT_…` (DDS) or `half`/`float` (EXR).
+    pub pixel_format: String,
+    pub bits: Bits,
+    pub width: usize,
+    pub height: usize,
+    /// What each stored channel holds, in order.
+    pub channels: Vec<String>,
+    pub samples: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub g_model: Option<GModel>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Sampling>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distribution: Option<Distribution>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blender_version: Option<String>,
+    /// Size of the written file.
+    pub bytes: usize,
+    /// Wall-clock seconds spent computing the table (excluding encoding and writing).
+    pub compute_seconds: f64,
+    /// Wall-clock seconds for the whole call.
+    pub seconds: f64,
+}
+
+/// Computes the table `args` asks for, encodes it in memory and writes it atomically to
+/// `args.out` (nothing is created on any error).
+pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
+    let start = Instant::now();
+    let spec = Spec::from_args(args)?;
+    let format = match args.format {
+        Some(f) => f,
+        None => Format::from_path(&args.out).ok_or_else(|| {
+            Error::input(
+                "--out",
+                &args.out.display().to_string(),
+                "a file name ending in .exr, .dds or .ktx2 (or give --format exr|dds|ktx)",
+            )
+        })?,
+    };
+    // A bad destination fails before minutes of computing, not after.
+    crate::output::check_destination(&args.out)?;
+    let t = Instant::now();
+    let table = spec.compute();
+    let compute_seconds = t.elapsed().as_secs_f64();
+    let bytes = encode(&table, format, args.bits).map_err(|message| Error::Write {
+        path: args.out.clone(),
+        message: format!("cannot encode the table as {}: {message}", format.key()),
+    })?;
+    crate::output::write_atomic(&args.out, &bytes)?;
+    let (samples, g_model, sampling, distribution, blender_version, channels) = match spec {
+        Spec::SplitSum {
+            samples,
+            g_model,
+            sampling,
+            ..
+        } => (
+            samples,
+            Some(g_model),
+            Some(sampling),
+            None,
+            None,
+            vec!["R: scale".to_string(), "G: bias".to_string()],
+        ),
+        Spec::KullaConty {
+            samples,
+            distribution,
+            blender_version,
+            ..
+        } => (
+            samples,
+            None,
+            None,
+            Some(distribution),
+            Some(blender_version.to_string()),
+            vec![
+                "R: scale".to_string(),
+                "G: bias".to_string(),
+                "B: integral of f_ms cos (≈ 1 − E)".to_string(),
+                "A: E_avg(r)".to_string(),
+            ],
+        ),
+    };
+    Ok(LutSummary {
+        path: args.out.clone(),
+        kind: args.kind,
+        format,
+        pixel_format: pixel_format_name(format, args.bits, table.channels.len()),
+        bits: args.bits,
+        width: table.width,
+        height: table.height,
+        channels,
+        samples,
+        g_model,
+        sampling,
+        distribution,
+        blender_version,
+        bytes: bytes.len(),
+        compute_seconds,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The human-readable summary `gloffuse lut` prints.
+pub fn describe(s: &LutSummary) -> String {
+    let mut out = format!(
+        "wrote {} ({} bytes): {} {}×{} {}, {} {}-bit\n",
+        s.path.display(),
+        s.bytes,
+        s.kind.key(),
+        s.width,
+        s.height,
+        s.format.key(),
+        s.pixel_format,
+        s.bits.count(),
+    );
+    let mut how = vec![format!("{} samples per texel", s.samples)];
+    if let Some(g) = s.g_model {
+        how.push(format!("{} masking", g.key()));
+    }
+    if let Some(m) = s.sampling {
+        how.push(format!("{} sampling", m.key()));
+    }
+    if let Some(d) = s.distribution {
+        how.push(format!("{d}"));
+    }
+    if let Some(v) = &s.blender_version {
+        how.push(format!("Blender {v}"));
+    }
+    out += &format!("  {}\n", how.join(", "));
+    for c in &s.channels {
+        out += &format!("  {c}\n");
+    }
+    out += &format!(
+        "  uv = (roughness, N·V); texel (x, y) at ((x + ½)/{}, (y + ½)/{}), first row first\n",
+        s.width, s.height
+    );
+    out += &format!(
+        "  computed in {:.2} s ({:.2} s in all)\n",
+        s.compute_seconds, s.seconds
+    );
+    out
+}
+
+fn pixel_format_name(format: Format, bits: Bits, channels: usize) -> String {
+    match format {
+        Format::Exr => match bits {
+            Bits::Half => "half".into(),
+            Bits::Float => "float".into(),
+        },
+        Format::Dds => dds::dxgi_format(bits, channels)
+            .map(|f| format!("DXGI_FORMAT_{f:?}").to_ascii_uppercase())
+            .unwrap_or_default(),
+        Format::Ktx => ktx2::VkFormat::of(bits, channels).name().into(),
+    }
+}

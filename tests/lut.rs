@@ -1,0 +1,794 @@
+//! The lookup tables: every container read back by an independent reader (exr, ddsfile,
+//! ktx2), split-sum values against oracles that share no code with the fast kernels,
+//! Kulla–Conty against the albedo integrator and an energy balance, and bad input.
+
+use clap::Parser;
+use gloffuse::Error;
+use gloffuse::blender::BlenderVersion;
+use gloffuse::lut::split_sum::{split_sum, split_sum_texel_f64};
+use gloffuse::lut::{Bits, Format, GModel, Kind, LutArgs, Sampling, Spec, Table, kulla_conty, lut};
+use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature};
+use half::f16;
+use std::io::Cursor;
+use std::path::Path;
+
+fn coord(i: usize, n: usize) -> f64 {
+    (i as f64 + 0.5) / n as f64
+}
+
+/// Small, fast requests of both kinds.
+fn small(kind: Kind, out: &Path, format: Format, bits: Bits) -> LutArgs {
+    let mut args = LutArgs::new(kind, out);
+    args.size = Some(match kind {
+        Kind::SplitSum => 24,
+        Kind::KullaConty => 8,
+    });
+    args.samples = Some(256);
+    args.format = Some(format);
+    args.bits = bits;
+    args
+}
+
+/// The value a reader must find for `v` stored at `bits`.
+fn stored(v: f32, bits: Bits) -> f32 {
+    match bits {
+        Bits::Half => f16::from_f32(v).to_f32(),
+        Bits::Float => v,
+    }
+}
+
+fn decode(bytes: &[u8], bits: Bits) -> Vec<f32> {
+    match bits {
+        Bits::Half => bytes
+            .chunks_exact(2)
+            .map(|b| f16::from_le_bytes([b[0], b[1]]).to_f32())
+            .collect(),
+        Bits::Float => bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect(),
+    }
+}
+
+/// Texel values must equal the computed table: bit for bit (compare bits, not ≈).
+fn assert_same_texels(found: &[f32], table: &Table, bits: Bits, what: &str) {
+    assert_eq!(found.len(), table.data.len(), "{what}: texel count");
+    for (i, (&f, &t)) in found.iter().zip(&table.data).enumerate() {
+        assert_eq!(
+            f.to_bits(),
+            stored(t, bits).to_bits(),
+            "{what}: value {i} is {f}, computed {t}"
+        );
+    }
+}
+
+const KINDS: [Kind; 2] = [Kind::SplitSum, Kind::KullaConty];
+const BITS: [Bits; 2] = [Bits::Half, Bits::Float];
+
+#[test]
+fn exr_reads_back_with_the_exr_crate() {
+    use exr::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    for kind in KINDS {
+        for bits in BITS {
+            let path = dir.path().join(format!("{kind:?}-{}.exr", bits.count()));
+            let args = small(kind, &path, Format::Exr, bits);
+            let table = Spec::from_args(&args).unwrap().compute();
+            let summary = lut(&args).unwrap();
+            assert_eq!(
+                summary.bytes as u64,
+                std::fs::metadata(&path).unwrap().len()
+            );
+            let bytes = std::fs::read(&path).unwrap();
+            let image = read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .all_channels()
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(Cursor::new(bytes))
+                .unwrap();
+            let layer = &image.layer_data;
+            assert_eq!(layer.size, Vec2(table.width, table.height));
+            assert_eq!(layer.encoding.compression, Compression::ZIP16);
+            let names: Vec<String> = layer
+                .channel_data
+                .list
+                .iter()
+                .map(|c| c.name.to_string())
+                .collect();
+            let mut expected: Vec<String> = table.channels.iter().map(|s| s.to_string()).collect();
+            expected.sort();
+            assert_eq!(
+                names, expected,
+                "{kind:?}: EXR channels (sorted, as EXR stores them)"
+            );
+            for channel in &layer.channel_data.list {
+                let c = table
+                    .channels
+                    .iter()
+                    .position(|&n| channel.name.to_string() == n)
+                    .unwrap();
+                let values: Vec<f32> = match (&channel.sample_data, bits) {
+                    (FlatSamples::F16(v), Bits::Half) => v.iter().map(|h| h.to_f32()).collect(),
+                    (FlatSamples::F32(v), Bits::Float) => v.clone(),
+                    (other, _) => panic!("{kind:?} {bits:?}: unexpected sample type {other:?}"),
+                };
+                let column = Table {
+                    width: table.width,
+                    height: table.height,
+                    channels: &["X"],
+                    data: (0..table.width * table.height)
+                        .map(|i| table.data[i * table.channels.len() + c])
+                        .collect(),
+                };
+                assert_same_texels(
+                    &values,
+                    &column,
+                    bits,
+                    &format!("EXR {kind:?} {}", channel.name),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn dds_reads_back_with_ddsfile() {
+    use ddsfile::{D3D10ResourceDimension, Dds, DxgiFormat};
+    let dir = tempfile::tempdir().unwrap();
+    for kind in KINDS {
+        for bits in BITS {
+            let path = dir.path().join(format!("{kind:?}-{}.dds", bits.count()));
+            let args = small(kind, &path, Format::Dds, bits);
+            let table = Spec::from_args(&args).unwrap().compute();
+            let summary = lut(&args).unwrap();
+            let dds = Dds::read(std::fs::File::open(&path).unwrap()).unwrap();
+            let expected = match (kind, bits) {
+                (Kind::SplitSum, Bits::Half) => DxgiFormat::R16G16_Float,
+                (Kind::SplitSum, Bits::Float) => DxgiFormat::R32G32_Float,
+                (Kind::KullaConty, Bits::Half) => DxgiFormat::R16G16B16A16_Float,
+                (Kind::KullaConty, Bits::Float) => DxgiFormat::R32G32B32A32_Float,
+            };
+            assert_eq!(dds.get_dxgi_format(), Some(expected));
+            let header10 = dds.header10.as_ref().expect("a DX10 header");
+            assert_eq!(
+                header10.resource_dimension,
+                D3D10ResourceDimension::Texture2D
+            );
+            assert_eq!(header10.array_size, 1);
+            assert_eq!(dds.get_width() as usize, table.width);
+            assert_eq!(dds.get_height() as usize, table.height);
+            assert_eq!(dds.get_num_mipmap_levels(), 1);
+            assert_eq!(
+                dds.get_pitch(),
+                Some(table.width as u32 * bits.count() / 8 * table.channels.len() as u32)
+            );
+            assert_eq!(
+                summary.pixel_format,
+                format!("DXGI_FORMAT_{expected:?}").to_uppercase()
+            );
+            assert_same_texels(&decode(&dds.data, bits), &table, bits, "DDS");
+        }
+    }
+}
+
+#[test]
+fn ktx2_reads_back_with_the_ktx2_crate() {
+    let dir = tempfile::tempdir().unwrap();
+    for kind in KINDS {
+        for bits in BITS {
+            let path = dir.path().join(format!("{kind:?}-{}.ktx2", bits.count()));
+            let args = small(kind, &path, Format::Ktx, bits);
+            let table = Spec::from_args(&args).unwrap().compute();
+            let summary = lut(&args).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            let reader = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
+            let header = reader.header();
+            let format = match (kind, bits) {
+                (Kind::SplitSum, Bits::Half) => ktx2::Format::R16G16_SFLOAT,
+                (Kind::SplitSum, Bits::Float) => ktx2::Format::R32G32_SFLOAT,
+                (Kind::KullaConty, Bits::Half) => ktx2::Format::R16G16B16A16_SFLOAT,
+                (Kind::KullaConty, Bits::Float) => ktx2::Format::R32G32B32A32_SFLOAT,
+            };
+            assert_eq!(header.format, Some(format));
+            assert_eq!(header.type_size, bits.count() / 8);
+            assert_eq!(header.pixel_width as usize, table.width);
+            assert_eq!(header.pixel_height as usize, table.height);
+            assert_eq!(header.pixel_depth, 0);
+            assert_eq!(header.layer_count, 0);
+            assert_eq!(header.face_count, 1);
+            assert_eq!(header.level_count, 1);
+            assert_eq!(header.supercompression_scheme, None);
+            assert_eq!(
+                (header.index.sgd_byte_offset, header.index.sgd_byte_length),
+                (0, 0)
+            );
+            assert_eq!(
+                header.index.dfd_byte_offset,
+                80 + 24,
+                "the DFD follows the level index"
+            );
+            assert_eq!(header.index.dfd_byte_offset % 4, 0);
+            assert_eq!(header.index.kvd_byte_offset % 4, 0);
+            assert_eq!(
+                summary.pixel_format,
+                format!("VK_FORMAT_{format:?}"),
+                "the summary names the Vulkan format"
+            );
+
+            // The DFD equals what the ktx2 crate's own generator makes for this format, and
+            // the bytes we wrote are exactly its serialisation.
+            let (expected_dfd, type_size) = ktx2::dfd::Basic::from_format(format).unwrap();
+            assert_eq!(type_size, header.type_size);
+            assert_eq!(
+                reader.dfd_blocks(),
+                &[ktx2::dfd::Block::Basic(expected_dfd.clone())]
+            );
+            let start = header.index.dfd_byte_offset as usize;
+            let total = u32::from_le_bytes(bytes[start..start + 4].try_into().unwrap());
+            assert_eq!(total, header.index.dfd_byte_length);
+            assert_eq!(
+                &bytes[start + 4..start + total as usize],
+                &ktx2::dfd::Block::Basic(expected_dfd).to_vec()[..]
+            );
+            let basic = reader.basic_dfd().unwrap();
+            assert_eq!(
+                basic.bytes_planes[0] as u32,
+                bits.count() / 8 * table.channels.len() as u32
+            );
+            assert_eq!(
+                basic.transfer_function,
+                Some(ktx2::TransferFunction::Linear)
+            );
+
+            let writer = reader.writer().unwrap().trim_end_matches('\0');
+            assert!(writer.starts_with("gloffuse "), "KTXwriter = {writer:?}");
+
+            let levels: Vec<_> = reader.levels().collect();
+            assert_eq!(levels.len(), 1);
+            assert_eq!(
+                levels[0].uncompressed_byte_length as usize,
+                levels[0].data.len()
+            );
+            let offset = levels[0].data.as_ptr() as usize - bytes.as_ptr() as usize;
+            let texel = (bits.count() / 8) as usize * table.channels.len();
+            assert_eq!(
+                offset % texel.max(4),
+                0,
+                "level data aligned to lcm(texel size, 4)"
+            );
+            assert_eq!(offset + levels[0].data.len(), bytes.len());
+            assert_same_texels(&decode(levels[0].data, bits), &table, bits, "KTX2");
+        }
+    }
+}
+
+#[test]
+fn half_floats_round_to_nearest() {
+    // One table, both depths: the 16-bit file holds the nearest half of every 32-bit value.
+    let dir = tempfile::tempdir().unwrap();
+    let mut values = Vec::new();
+    for bits in BITS {
+        let path = dir.path().join(format!("t{}.ktx2", bits.count()));
+        lut(&small(Kind::SplitSum, &path, Format::Ktx, bits)).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let reader = ktx2::Reader::new(&bytes[..]).unwrap();
+        values.push(decode(reader.levels().next().unwrap().data, bits));
+    }
+    for (h, f) in values[0].iter().zip(&values[1]) {
+        let err = (h - f).abs();
+        // Half has 11 significant bits: half an ulp below 1 is at most 2^-12.
+        assert!(
+            err <= 2f32.powi(-12) * f.abs().max(2f32.powi(-14)) * 2.0 + 1e-7,
+            "{h} vs {f}"
+        );
+    }
+}
+
+// ---- split-sum values ----
+
+#[test]
+fn split_sum_mirror_limit_is_one() {
+    // Column 0 of a 256 table: r = 1/512, α ≈ 4e-6 — a mirror. Then H = N, V·H = N·V,
+    // so scale + bias = G ≈ 1 and bias = (1 − N·V)⁵.
+    let n = 256;
+    for g in [GModel::Ue4, GModel::HeightCorrelated] {
+        for sampling in [Sampling::VisibleNormals, Sampling::Classic] {
+            let t = split_sum(n, 256, g, sampling);
+            for y in (n / 10..n).step_by(7) {
+                let nov = coord(y, n);
+                let (s, b) = (f64::from(t[y * n * 2]), f64::from(t[y * n * 2 + 1]));
+                assert!(
+                    (s + b - 1.0).abs() < 1e-3,
+                    "{g:?} {sampling:?} N·V {nov}: {s} + {b}"
+                );
+                assert!(
+                    (b - (1.0 - nov).powi(5)).abs() < 1e-3,
+                    "{g:?} N·V {nov}: bias {b}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn split_sum_matches_a_converged_brute_force() {
+    // The textbook estimator in plain f64 with 2^20 samples converges away from grazing;
+    // the default table (visible normals, 2048 samples, f32 kernel) must agree within 1e-3.
+    let n = 64;
+    for g in [GModel::Ue4, GModel::HeightCorrelated] {
+        let t = split_sum(n, 2048, g, Sampling::VisibleNormals);
+        for &(x, y) in &[
+            (3, 20),
+            (10, 40),
+            (20, 13),
+            (31, 63),
+            (45, 30),
+            (63, 50),
+            (50, 60),
+        ] {
+            let (s, b) =
+                split_sum_texel_f64(coord(x, n), coord(y, n), 1 << 20, g, Sampling::Classic);
+            let i = (y * n + x) * 2;
+            let (ts, tb) = (f64::from(t[i]), f64::from(t[i + 1]));
+            assert!(
+                (ts - s).abs() < 1e-3 && (tb - b).abs() < 1e-3,
+                "{g:?} texel ({x}, {y}): table ({ts:.5}, {tb:.5}), brute force ({s:.5}, {b:.5})"
+            );
+        }
+    }
+}
+
+#[test]
+fn fast_kernels_equal_the_plain_f64_estimators() {
+    // Same points, same formulas: only f32 rounding may differ.
+    let n = 32;
+    for g in [GModel::Ue4, GModel::HeightCorrelated] {
+        for sampling in [Sampling::VisibleNormals, Sampling::Classic] {
+            let t = split_sum(n, 333, g, sampling);
+            for &(x, y) in &[(0, 0), (5, 1), (17, 9), (31, 31), (25, 3), (2, 28)] {
+                let (s, b) = split_sum_texel_f64(coord(x, n), coord(y, n), 333, g, sampling);
+                let i = (y * n + x) * 2;
+                let tol = 2e-5 * (1.0 + s.abs().max(b.abs()) * 10.0);
+                assert!(
+                    (f64::from(t[i]) - s).abs() < tol && (f64::from(t[i + 1]) - b).abs() < tol,
+                    "{g:?} {sampling:?} ({x}, {y}): ({}, {}) vs ({s}, {b})",
+                    t[i],
+                    t[i + 1]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn height_correlated_scale_plus_bias_is_the_cycles_albedo() {
+    // With Smith height-correlated G, scale + bias is exactly the directional albedo of
+    // Cycles' GGX (Blender ≥ 3.6), which the albedo integrator computes by quadrature —
+    // including at grazing views, where the classic estimator is off by 1e-2.
+    let n = 128;
+    let t = split_sum(n, 2048, GModel::HeightCorrelated, Sampling::VisibleNormals);
+    let fine = AlbedoIntegrator::new(Quadrature {
+        theta: 64,
+        phi: 24,
+        mu: 32,
+    });
+    for &(x, y) in &[
+        (0, 0),
+        (3, 0),
+        (10, 1),
+        (30, 0),
+        (60, 2),
+        (127, 0),
+        (20, 64),
+        (90, 100),
+        (127, 127),
+    ] {
+        let glossy = Glossy {
+            distribution: Distribution::Ggx,
+            masking: Masking::HeightCorrelated,
+            alpha: coord(x, n).powi(2),
+        };
+        let e = fine.directional_albedo(&glossy, coord(y, n));
+        let i = (y * n + x) * 2;
+        let sum = f64::from(t[i]) + f64::from(t[i + 1]);
+        assert!(
+            (sum - e).abs() < 1e-3,
+            "({x}, {y}): scale + bias {sum:.5}, E {e:.5}"
+        );
+    }
+}
+
+#[test]
+fn split_sum_properties() {
+    let n = 64;
+    for g in [GModel::Ue4, GModel::HeightCorrelated] {
+        let t = split_sum(n, 2048, g, Sampling::VisibleNormals);
+        for y in 0..n {
+            for x in 0..n {
+                let i = (y * n + x) * 2;
+                let (s, b) = (t[i], t[i + 1]);
+                assert!(s >= 0.0 && b >= 0.0, "{g:?} ({x}, {y}): ({s}, {b})");
+                assert!(
+                    s + b <= 1.0 + 1e-3,
+                    "{g:?} ({x}, {y}): scale + bias = {}",
+                    s + b
+                );
+                // Looking straight on, V·H stays near 1 for all but the roughest lobes, so
+                // the Fresnel part is small.
+                if y == n - 1 {
+                    assert!(
+                        b < 0.05,
+                        "{g:?} r = {}: bias at N·V = 1 is {b}",
+                        coord(x, n)
+                    );
+                }
+            }
+            // Energy is lost as roughness grows, for views away from grazing. (At grazing
+            // views the true albedo dips where α ≈ N·V and recovers — the albedo quadrature
+            // shows the same dip — so no monotonicity there.)
+            if coord(y, n) < 0.25 {
+                continue;
+            }
+            for x in 1..n {
+                let (a, c) = ((y * n + x - 1) * 2, (y * n + x) * 2);
+                assert!(
+                    t[c] + t[c + 1] <= t[a] + t[a + 1] + 2e-3,
+                    "{g:?} row {y}: scale + bias rises from x = {} to {x}",
+                    x - 1
+                );
+            }
+        }
+    }
+    // A measured number: the centre of a white GGX r = 1 furnace sphere renders at
+    // 0.305–0.308 in Blender 4.5 (DESIGN.md §2), i.e. E(N·V = 1, r = 1) with Smith
+    // height-correlated G, which is scale + bias at (r, N·V) = (1, 1).
+    let (s, b) = split_sum_texel_f64(
+        1.0,
+        1.0,
+        1 << 16,
+        GModel::HeightCorrelated,
+        Sampling::VisibleNormals,
+    );
+    assert!((s + b - 0.3065).abs() < 0.004, "E(1, 1) = {}", s + b);
+    let (s, b) = split_sum_texel_f64(
+        1.0,
+        1.0,
+        1 << 16,
+        GModel::HeightCorrelated,
+        Sampling::Classic,
+    );
+    assert!(
+        (s + b - 0.3065).abs() < 0.004,
+        "classic E(1, 1) = {}",
+        s + b
+    );
+}
+
+// ---- Kulla–Conty ----
+
+#[test]
+fn kulla_conty_e_and_e_avg_are_the_integrators() {
+    let integrator = AlbedoIntegrator::default();
+    let n = 8;
+    for d in Distribution::ALL {
+        for masking in [Masking::Separable, Masking::HeightCorrelated] {
+            let kc = kulla_conty::kulla_conty(n, 64, d, masking);
+            for x in 0..n {
+                let glossy = Glossy {
+                    distribution: d,
+                    masking,
+                    alpha: coord(x, n).powi(2),
+                };
+                assert_eq!(
+                    kc.e_avg[x],
+                    integrator.average_albedo(&glossy),
+                    "{d} E_avg[{x}]"
+                );
+                for y in 0..n {
+                    assert_eq!(
+                        kc.e[y * n + x],
+                        integrator.directional_albedo(&glossy, coord(y, n)),
+                        "{d} E({y}, {x})"
+                    );
+                }
+            }
+            // The RGBA table carries scale, bias, ∫f_ms cos and E_avg.
+            let table = kc.table();
+            assert_eq!(table.channels, &["R", "G", "B", "A"]);
+            for y in 0..n {
+                for x in 0..n {
+                    let i = y * n + x;
+                    assert_eq!(table.get(x, y, 0), kc.scale[i] as f32);
+                    assert_eq!(table.get(x, y, 1), kc.bias[i] as f32);
+                    assert_eq!(table.get(x, y, 2), kc.fms[i] as f32);
+                    assert_eq!(table.get(x, y, 3), kc.e_avg[x] as f32);
+                }
+            }
+        }
+    }
+}
+
+/// `∫ f_ms(μ, μi) cosθi dωi = 2π ∫₀¹ f_ms(μ, μi) μi dμi` by a plain midpoint rule, with
+/// f_ms built from the table's E column and the integrator's E_avg as DESIGN.md defines it.
+fn fms_brute_force(kc: &kulla_conty::KullaConty, x: usize, y: usize) -> f64 {
+    let n = kc.size;
+    let column: Vec<f64> = (0..n).map(|j| kc.e[j * n + x]).collect();
+    let e = |mu: f64| kulla_conty::interpolate(&column, mu).min(1.0);
+    let e_avg = kc.e_avg[x];
+    let m = 20_000;
+    let sum: f64 = (0..m)
+        .map(|k| {
+            let mu_i = (k as f64 + 0.5) / m as f64;
+            (1.0 - e(coord(y, n))) * (1.0 - e(mu_i)) / (std::f64::consts::PI * (1.0 - e_avg)) * mu_i
+        })
+        .sum();
+    2.0 * std::f64::consts::PI * sum / m as f64
+}
+
+#[test]
+fn kulla_conty_restores_the_missing_energy() {
+    let n = 32;
+    for d in Distribution::ALL {
+        let kc = kulla_conty::kulla_conty(n, 4096, d, Masking::HeightCorrelated);
+        for &(x, y) in &[
+            (16, 0),
+            (16, 8),
+            (31, 0),
+            (31, 16),
+            (31, 31),
+            (24, 4),
+            (20, 25),
+            (12, 2),
+        ] {
+            let i = y * n + x;
+            let (e, b) = (kc.e[i], kc.fms[i]);
+            // B is the integral of the lobe …
+            let brute = fms_brute_force(&kc, x, y);
+            assert!(
+                (b - brute).abs() < 1e-6,
+                "{d} ({x}, {y}): B {b}, brute force {brute}"
+            );
+            // … and the lobe gives back what single scattering loses.
+            assert!(
+                (e + b - 1.0).abs() < 2e-3,
+                "{d} r = {:.3}, μ = {:.3}: E {e:.5} + ∫f_ms cos {b:.5} = {:.5}",
+                coord(x, n),
+                coord(y, n),
+                e + b
+            );
+            // R + G estimates E (Cycles' sampling, 4096 samples).
+            let rg = kc.scale[i] + kc.bias[i];
+            assert!(
+                (rg - e).abs() < 2e-3,
+                "{d} ({x}, {y}): R + G {rg:.5}, E {e:.5}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sampled_fms_estimator_converges_to_the_closed_form() {
+    // DESIGN.md's estimator (f_ms · 4 N·L L·H / (N·H D) with GGX sampling) and the closed
+    // form are the same integral; on a rough lobe the estimator is already close.
+    let n = 16;
+    let kc = kulla_conty::kulla_conty(n, 256, Distribution::Ggx, Masking::HeightCorrelated);
+    for &(x, y) in &[(15, 3), (15, 12), (12, 8)] {
+        let column: Vec<f64> = (0..n).map(|j| kc.e[j * n + x]).collect();
+        let glossy = Glossy {
+            distribution: Distribution::Ggx,
+            masking: Masking::HeightCorrelated,
+            alpha: coord(x, n).powi(2),
+        };
+        let sampled = kulla_conty::fms_sampled(&glossy, coord(y, n), 1 << 16, &column, kc.e_avg[x]);
+        let b = kc.fms[y * n + x];
+        assert!(
+            (sampled - b).abs() < 0.02 * b.max(0.05),
+            "({x}, {y}): sampled {sampled}, closed form {b}"
+        );
+    }
+}
+
+#[test]
+fn kulla_conty_ggx_scale_bias_is_the_height_correlated_split_sum() {
+    // Blender 4.x GGX with Fresnel-Schlick: the Kulla–Conty R, G are the split-sum table
+    // with Smith height-correlated G (same visible-normal points, f64 vs the f32 kernel).
+    let n = 16;
+    let mut args = LutArgs::new(Kind::KullaConty, "unused.exr");
+    args.size = Some(n as u32);
+    args.samples = Some(512);
+    args.blender_version = Some("4.5".parse::<BlenderVersion>().unwrap());
+    let kc = Spec::from_args(&args).unwrap().compute();
+    let ss = split_sum(n, 512, GModel::HeightCorrelated, Sampling::VisibleNormals);
+    for y in 0..n {
+        for x in 0..n {
+            for c in 0..2 {
+                let (a, b) = (kc.get(x, y, c), ss[(y * n + x) * 2 + c]);
+                assert!((a - b).abs() < 3e-5, "({x}, {y}) channel {c}: {a} vs {b}");
+            }
+        }
+    }
+}
+
+// ---- bad input ----
+
+fn assert_input_error(args: &LutArgs, flag: &str) {
+    match lut(args) {
+        Err(e @ Error::Input { .. }) => {
+            let message = e.to_string();
+            assert!(message.contains(flag), "{message:?} should name {flag}");
+        }
+        other => panic!("{flag}: expected an input error, got {other:?}"),
+    }
+    assert!(!args.out.exists(), "{flag}: no file may be created");
+}
+
+#[test]
+fn bad_input_is_refused_and_creates_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lut.ktx2");
+    for size in [0, 8193, 100_000] {
+        let mut args = LutArgs::new(Kind::SplitSum, &out);
+        args.size = Some(size);
+        assert_input_error(&args, "--size");
+    }
+    for samples in [0, (1 << 20) + 1] {
+        let mut args = LutArgs::new(Kind::KullaConty, &out);
+        args.samples = Some(samples);
+        assert_input_error(&args, "--samples");
+    }
+    let mut args = LutArgs::new(Kind::SplitSum, &out);
+    args.distribution = Some(Distribution::Beckmann);
+    assert_input_error(&args, "--distribution");
+    let mut args = LutArgs::new(Kind::SplitSum, &out);
+    args.blender_version = Some("3.4".parse().unwrap());
+    assert_input_error(&args, "--blender-version");
+    let mut args = LutArgs::new(Kind::KullaConty, &out);
+    args.g_model = Some(GModel::Ue4);
+    assert_input_error(&args, "--g-model");
+    let mut args = LutArgs::new(Kind::KullaConty, &out);
+    args.sampling = Some(Sampling::Classic);
+    assert_input_error(&args, "--sampling");
+    // No --format and an extension that names none.
+    let args = LutArgs::new(Kind::SplitSum, dir.path().join("lut.png"));
+    assert_input_error(&args, "--out");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn unwritable_out_is_an_error_naming_the_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        dir.path().join("missing-dir").join("lut.exr"),
+        dir.path().to_path_buf(), // a directory
+    ];
+    for out in cases {
+        let mut args = LutArgs::new(Kind::SplitSum, &out);
+        args.size = Some(4);
+        args.format = Some(Format::Exr);
+        match lut(&args) {
+            Err(e @ Error::Write { .. }) => {
+                assert!(e.to_string().contains(&out.display().to_string()), "{e}");
+            }
+            other => panic!("{}: expected a write error, got {other:?}", out.display()),
+        }
+    }
+    assert!(!dir.path().join("missing-dir").exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no stray temporary file"
+    );
+}
+
+// ---- the command-line surface and the summary ----
+
+#[derive(Parser)]
+struct Cli {
+    #[command(flatten)]
+    lut: LutArgs,
+}
+
+#[test]
+fn flags_parse_and_are_documented() {
+    let cli = Cli::try_parse_from([
+        "lut",
+        "--kind",
+        "kulla-conty",
+        "--distribution",
+        "ASHIKHMIN_SHIRLEY",
+        "--blender-version",
+        "3.4.1",
+        "--size",
+        "32",
+        "--samples",
+        "100",
+        "--bits",
+        "32",
+        "--format",
+        "ktx",
+        "--out",
+        "x.ktx2",
+    ])
+    .unwrap();
+    let a = cli.lut;
+    assert_eq!(a.kind, Kind::KullaConty);
+    assert_eq!(a.distribution, Some(Distribution::AshikhminShirley));
+    assert_eq!(a.blender_version.unwrap().masking(), Masking::Separable);
+    assert_eq!(
+        (a.size, a.samples, a.bits),
+        (Some(32), Some(100), Bits::Float)
+    );
+    assert_eq!(a.format, Some(Format::Ktx));
+
+    let cli = Cli::try_parse_from([
+        "lut",
+        "--g-model",
+        "height-correlated",
+        "--bits",
+        "16",
+        "--format",
+        "dds",
+        "-o",
+        "y",
+    ])
+    .unwrap();
+    assert_eq!(cli.lut.kind, Kind::SplitSum);
+    assert_eq!(cli.lut.g_model, Some(GModel::HeightCorrelated));
+    assert!(Cli::try_parse_from(["lut", "--bits", "8", "--out", "z.exr"]).is_err());
+    assert!(
+        Cli::try_parse_from(["lut", "--kind", "split-sum"]).is_err(),
+        "--out is required"
+    );
+
+    let command = <Cli as clap::CommandFactory>::command();
+    let mut flags = Vec::new();
+    for arg in command.get_arguments() {
+        let Some(long) = arg.get_long() else { continue };
+        flags.push(long.to_string());
+        let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+        assert!(
+            help.split_whitespace().count() >= 4,
+            "--{long} has no real help: {help:?}"
+        );
+    }
+    for flag in [
+        "kind",
+        "distribution",
+        "blender-version",
+        "size",
+        "samples",
+        "bits",
+        "g-model",
+        "sampling",
+        "format",
+        "out",
+    ] {
+        assert!(flags.iter().any(|f| f == flag), "--{flag} missing");
+    }
+}
+
+#[test]
+fn summary_says_what_was_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("brdf.dds");
+    let mut args = LutArgs::new(Kind::SplitSum, &out);
+    args.size = Some(16);
+    let summary = lut(&args).unwrap();
+    assert_eq!(summary.format, Format::Dds, "format from the extension");
+    assert_eq!(
+        (summary.width, summary.height, summary.samples),
+        (16, 16, 2048)
+    );
+    let json = serde_json::to_value(&summary).unwrap();
+    assert_eq!(json["kind"], "split-sum");
+    assert_eq!(json["format"], "dds");
+    assert_eq!(json["bits"], "16");
+    assert_eq!(json["g_model"], "ue4");
+    assert_eq!(json["sampling"], "visible-normals");
+    assert_eq!(json["pixel_format"], "DXGI_FORMAT_R16G16_FLOAT");
+    assert!(json["seconds"].as_f64().unwrap() >= json["compute_seconds"].as_f64().unwrap());
+    assert_eq!(json["channels"][0], "R: scale");
+    assert!(out.exists());
+}
