@@ -21,9 +21,10 @@ fn small(kind: Kind, out: &Path, format: Format, bits: Bits) -> LutArgs {
     let mut args = LutArgs::new(kind, out);
     args.size = Some(match kind {
         Kind::SplitSum => 24,
-        Kind::KullaConty => 8,
+        Kind::KullaConty | Kind::Albedo => 8,
     });
-    args.samples = Some(256);
+    // The albedo table is quadrature: it takes no samples.
+    args.samples = (kind != Kind::Albedo).then_some(256);
     args.format = Some(format);
     args.bits = bits;
     args
@@ -62,7 +63,7 @@ fn assert_same_texels(found: &[f32], table: &Table, bits: Bits, what: &str) {
     }
 }
 
-const KINDS: [Kind; 2] = [Kind::SplitSum, Kind::KullaConty];
+const KINDS: [Kind; 3] = [Kind::SplitSum, Kind::KullaConty, Kind::Albedo];
 const BITS: [Bits; 2] = [Bits::Half, Bits::Float];
 
 #[test]
@@ -145,8 +146,8 @@ fn dds_reads_back_with_ddsfile() {
             let summary = lut(&args).unwrap();
             let dds = Dds::read(std::fs::File::open(&path).unwrap()).unwrap();
             let expected = match (kind, bits) {
-                (Kind::SplitSum, Bits::Half) => DxgiFormat::R16G16_Float,
-                (Kind::SplitSum, Bits::Float) => DxgiFormat::R32G32_Float,
+                (Kind::SplitSum | Kind::Albedo, Bits::Half) => DxgiFormat::R16G16_Float,
+                (Kind::SplitSum | Kind::Albedo, Bits::Float) => DxgiFormat::R32G32_Float,
                 (Kind::KullaConty, Bits::Half) => DxgiFormat::R16G16B16A16_Float,
                 (Kind::KullaConty, Bits::Float) => DxgiFormat::R32G32B32A32_Float,
             };
@@ -186,8 +187,8 @@ fn ktx2_reads_back_with_the_ktx2_crate() {
             let reader = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             let header = reader.header();
             let format = match (kind, bits) {
-                (Kind::SplitSum, Bits::Half) => ktx2::Format::R16G16_SFLOAT,
-                (Kind::SplitSum, Bits::Float) => ktx2::Format::R32G32_SFLOAT,
+                (Kind::SplitSum | Kind::Albedo, Bits::Half) => ktx2::Format::R16G16_SFLOAT,
+                (Kind::SplitSum | Kind::Albedo, Bits::Float) => ktx2::Format::R32G32_SFLOAT,
                 (Kind::KullaConty, Bits::Half) => ktx2::Format::R16G16B16A16_SFLOAT,
                 (Kind::KullaConty, Bits::Float) => ktx2::Format::R32G32B32A32_SFLOAT,
             };
@@ -510,6 +511,48 @@ fn kulla_conty_e_and_e_avg_are_the_integrators() {
     }
 }
 
+/// The albedo table against two independent estimators: R = E(μ, r) against the sampled
+/// split-sum pair of the Kulla–Conty table (scale + bias: Monte Carlo over the same BSDF),
+/// and G = E_avg(r) against 2∫E(μ)μ dμ by the midpoint rule over the R column itself.
+#[test]
+fn albedo_table_is_e_and_its_hemispherical_average() {
+    let n = 32;
+    for d in Distribution::ALL {
+        for masking in [Masking::Separable, Masking::HeightCorrelated] {
+            let table = kulla_conty::albedo_table(n, d, masking);
+            assert_eq!(table.channels, &["R", "G"]);
+            let kc = kulla_conty::kulla_conty(n, 4096, d, masking);
+            let mut worst_e: f64 = 0.0;
+            for x in 0..n {
+                let mut midpoint = 0.0;
+                for y in 0..n {
+                    let e = table.get(x, y, 0) as f64;
+                    assert!((0.0..=1.0).contains(&e), "{d} E({y}, {x}) = {e}");
+                    let i = y * n + x;
+                    worst_e = worst_e.max((e - (kc.scale[i] + kc.bias[i])).abs());
+                    midpoint += 2.0 * e * coord(y, n) / n as f64;
+                    assert_eq!(
+                        table.get(x, y, 1),
+                        table.get(x, 0, 1),
+                        "G constant in a column"
+                    );
+                }
+                let e_avg = table.get(x, 0, 1) as f64;
+                // Measured: the midpoint rule over 32 rows is within 1e-4; E vs scale + bias within 5.1e-4.
+                assert!(
+                    (e_avg - midpoint).abs() < 5e-4,
+                    "{d} {masking:?} r = {}: E_avg {e_avg} vs midpoint {midpoint}",
+                    coord(x, n)
+                );
+            }
+            assert!(
+                worst_e < 1e-3,
+                "{d} {masking:?}: E vs scale + bias off by {worst_e}"
+            );
+        }
+    }
+}
+
 /// `∫ f_ms(μ, μi) cosθi dωi = 2π ∫₀¹ f_ms(μ, μi) μi dμi` by a plain midpoint rule, with
 /// f_ms built from the table's E column and the integrator's E_avg as DESIGN.md defines it.
 fn fms_brute_force(kc: &kulla_conty::KullaConty, x: usize, y: usize) -> f64 {
@@ -650,6 +693,12 @@ fn bad_input_is_refused_and_creates_nothing() {
     let mut args = LutArgs::new(Kind::KullaConty, &out);
     args.sampling = Some(Sampling::Classic);
     assert_input_error(&args, "--sampling");
+    let mut args = LutArgs::new(Kind::Albedo, &out);
+    args.samples = Some(64);
+    assert_input_error(&args, "--samples");
+    let mut args = LutArgs::new(Kind::Albedo, &out);
+    args.g_model = Some(GModel::HeightCorrelated);
+    assert_input_error(&args, "--g-model");
     // No --format and an extension that names none.
     let args = LutArgs::new(Kind::SplitSum, dir.path().join("lut.png"));
     assert_input_error(&args, "--out");
@@ -779,7 +828,7 @@ fn summary_says_what_was_written() {
     assert_eq!(summary.format, Format::Dds, "format from the extension");
     assert_eq!(
         (summary.width, summary.height, summary.samples),
-        (16, 16, 2048)
+        (16, 16, Some(2048))
     );
     let json = serde_json::to_value(&summary).unwrap();
     assert_eq!(json["kind"], "split-sum");

@@ -250,6 +250,40 @@ pub fn scale_bias(glossy: &Glossy, mu: f64, samples: u32) -> (f64, f64) {
     (scale / n, bias / n)
 }
 
+/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`, both Cycles-exact quadrature
+/// (columns in parallel).
+pub fn albedo_table(size: usize, distribution: Distribution, masking: Masking) -> Table {
+    let integrator = AlbedoIntegrator::default();
+    let n = size as f64;
+    let columns: Vec<(Vec<f64>, f64)> = (0..size)
+        .into_par_iter()
+        .map(|x| {
+            let r = (x as f64 + 0.5) / n;
+            let glossy = Glossy {
+                distribution,
+                masking,
+                alpha: r * r,
+            };
+            let e = (0..size)
+                .map(|y| integrator.directional_albedo(&glossy, (y as f64 + 0.5) / n))
+                .collect();
+            (e, integrator.average_albedo(&glossy))
+        })
+        .collect();
+    let mut data = Vec::with_capacity(size * size * 2);
+    for y in 0..size {
+        for (e, e_avg) in &columns {
+            data.extend_from_slice(&[e[y] as f32, *e_avg as f32]);
+        }
+    }
+    Table {
+        width: size,
+        height: size,
+        channels: &["R", "G"],
+        data,
+    }
+}
+
 /// Computes the Kulla–Conty tables for `distribution` with `masking`, `size × size`
 /// texels, `samples` Hammersley points per texel (columns in parallel).
 pub fn kulla_conty(

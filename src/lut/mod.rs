@@ -16,6 +16,10 @@
 //!   0.45 s (height-correlated) on 2 cores, within 7.2e-4 of the converged table
 //!   (`cargo bench --bench lut`); `--sampling classic` is DESIGN.md §5 verbatim (1e-2 off
 //!   near grazing at 1024 samples).
+//! * [`Kind::Albedo`], 2 channels, for the same Glossy BSDF: **R = E(μ, r)** and
+//!   **G = E_avg(r)** (constant along each column), both by the deterministic quadrature of
+//!   [`crate::microfacet::AlbedoIntegrator`] (no samples; max error 3.2e-5): the two
+//!   Kulla–Conty tables a renderer needs to build its own compensation.
 //! * [`Kind::KullaConty`], 4 channels, for the Glossy BSDF that Cycles evaluates (chosen by
 //!   `--distribution` and `--blender-version`; see [`kulla_conty`]):
 //!   **R = scale, G = bias** (the same split-sum pair, integrated over Cycles' BSDF, so
@@ -61,6 +65,8 @@ pub enum Kind {
     SplitSum,
     /// Kulla–Conty for a Cycles Glossy BSDF (R = scale, G = bias, B = ∫f_ms cos, A = E_avg).
     KullaConty,
+    /// Kulla–Conty's albedo tables for a Cycles Glossy BSDF (R = E(μ, r), G = E_avg(r)).
+    Albedo,
 }
 
 impl Kind {
@@ -68,6 +74,7 @@ impl Kind {
         match self {
             Kind::SplitSum => "split-sum",
             Kind::KullaConty => "kulla-conty",
+            Kind::Albedo => "albedo",
         }
     }
 }
@@ -173,23 +180,23 @@ impl Bits {
 /// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
 #[derive(clap::Args, Debug, Clone, PartialEq)]
 pub struct LutArgs {
-    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA).
+    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G).
     #[arg(long, value_enum, default_value_t = Kind::SplitSum)]
     pub kind: Kind,
 
-    /// kulla-conty only: beckmann, ggx or ashikhmin-shirley [default: ggx].
+    /// kulla-conty and albedo: beckmann, ggx or ashikhmin-shirley [default: ggx].
     #[arg(long, short = 'd', value_parser = crate::cli::parse_distribution)]
     pub distribution: Option<Distribution>,
 
-    /// kulla-conty only: the Blender whose masking the BSDF follows (3.x separable, 3.6+ height-correlated) [default: 4.5].
+    /// kulla-conty and albedo: the Blender whose masking the BSDF follows (3.x separable, 3.6+ height-correlated) [default: 4.5].
     #[arg(long, value_parser = crate::cli::parse_version)]
     pub blender_version: Option<BlenderVersion>,
 
-    /// Texels per side, 1 to 8192 [default: 512 for split-sum, 64 for kulla-conty].
+    /// Texels per side, 1 to 8192 [default: 512 for split-sum, 64 for kulla-conty and albedo].
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
 
-    /// Hammersley samples per texel, 1 to 1048576 [default: 2048 split-sum (max error 7e-4), 4096 kulla-conty].
+    /// Hammersley samples per texel, 1 to 1048576 [default: 2048 split-sum (max error 7e-4), 4096 kulla-conty; albedo takes none: it is quadrature].
     #[arg(long, value_name = "N")]
     pub samples: Option<u32>,
 
@@ -283,6 +290,11 @@ pub enum Spec {
         distribution: Distribution,
         blender_version: BlenderVersion,
     },
+    Albedo {
+        size: usize,
+        distribution: Distribution,
+        blender_version: BlenderVersion,
+    },
 }
 
 impl Spec {
@@ -291,6 +303,7 @@ impl Spec {
         let (default_size, default_samples) = match args.kind {
             Kind::SplitSum => (512, 2048),
             Kind::KullaConty => (64, 4096),
+            Kind::Albedo => (64, 1),
         };
         let size = args.size.unwrap_or(default_size);
         let samples = args.samples.unwrap_or(default_samples);
@@ -332,28 +345,47 @@ impl Spec {
                     sampling: args.sampling.unwrap_or(Sampling::VisibleNormals),
                 })
             }
-            Kind::KullaConty => {
+            Kind::KullaConty | Kind::Albedo => {
+                let kind = args.kind.key();
                 if let Some(g) = args.g_model {
                     return Err(Error::input(
                         "--g-model",
                         g.key(),
-                        "nothing with --kind kulla-conty (its masking follows --blender-version; --g-model applies to split-sum)",
+                        &format!(
+                            "nothing with --kind {kind} (its masking follows --blender-version; --g-model applies to split-sum)"
+                        ),
                     ));
                 }
                 if let Some(s) = args.sampling {
                     return Err(Error::input(
                         "--sampling",
                         s.key(),
-                        "nothing with --kind kulla-conty (it samples each distribution's own D·cosθh; --sampling applies to split-sum)",
+                        &format!("nothing with --kind {kind} (--sampling applies to split-sum)"),
                     ));
                 }
-                Ok(Spec::KullaConty {
+                let distribution = args.distribution.unwrap_or(Distribution::Ggx);
+                let blender_version = args
+                    .blender_version
+                    .unwrap_or(BlenderVersion { major: 4, minor: 5 });
+                if args.kind == Kind::KullaConty {
+                    return Ok(Spec::KullaConty {
+                        size,
+                        samples,
+                        distribution,
+                        blender_version,
+                    });
+                }
+                if let Some(n) = args.samples {
+                    return Err(Error::input(
+                        "--samples",
+                        &n.to_string(),
+                        "nothing with --kind albedo (E is integrated by deterministic quadrature, not sampled)",
+                    ));
+                }
+                Ok(Spec::Albedo {
                     size,
-                    samples,
-                    distribution: args.distribution.unwrap_or(Distribution::Ggx),
-                    blender_version: args
-                        .blender_version
-                        .unwrap_or(BlenderVersion { major: 4, minor: 5 }),
+                    distribution,
+                    blender_version,
                 })
             }
         }
@@ -380,6 +412,11 @@ impl Spec {
                 blender_version,
             } => kulla_conty::kulla_conty(size, samples, distribution, blender_version.masking())
                 .table(),
+            Spec::Albedo {
+                size,
+                distribution,
+                blender_version,
+            } => kulla_conty::albedo_table(size, distribution, blender_version.masking()),
         }
     }
 }
@@ -407,7 +444,9 @@ pub struct LutSummary {
     pub height: usize,
     /// What each stored channel holds, in order.
     pub channels: Vec<String>,
-    pub samples: u32,
+    /// Samples per texel (none for `albedo`, which is quadrature).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub samples: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub g_model: Option<GModel>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -456,7 +495,7 @@ pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
             sampling,
             ..
         } => (
-            samples,
+            Some(samples),
             Some(g_model),
             Some(sampling),
             None,
@@ -469,7 +508,7 @@ pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
             blender_version,
             ..
         } => (
-            samples,
+            Some(samples),
             None,
             None,
             Some(distribution),
@@ -480,6 +519,18 @@ pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
                 "B: integral of f_ms cos (≈ 1 − E)".to_string(),
                 "A: E_avg(r)".to_string(),
             ],
+        ),
+        Spec::Albedo {
+            distribution,
+            blender_version,
+            ..
+        } => (
+            None,
+            None,
+            None,
+            Some(distribution),
+            Some(blender_version.to_string()),
+            vec!["R: E(μ, r)".to_string(), "G: E_avg(r)".to_string()],
         ),
     };
     Ok(LutSummary {
@@ -515,7 +566,10 @@ pub fn describe(s: &LutSummary) -> String {
         s.pixel_format,
         s.bits.count(),
     );
-    let mut how = vec![format!("{} samples per texel", s.samples)];
+    let mut how = vec![match s.samples {
+        Some(n) => format!("{n} samples per texel"),
+        None => "deterministic quadrature".to_string(),
+    }];
     if let Some(g) = s.g_model {
         how.push(format!("{} masking", g.key()));
     }
