@@ -342,42 +342,22 @@ mod tests {
 
     #[test]
     fn refuses_bad_point_sets() {
-        assert!(
-            fit_polynomial(
-                &pts(&[(0.5, 97.0)]),
+        // Too few points, a repeated roughness, degree above 8, degree below 2.
+        let cases: [(&[(f64, f64)], usize); 4] = [
+            (&[(0.5, 97.0)], 3),
+            (&[(0.5, 97.0), (0.5, 90.0)], 3),
+            (&[(0.5, 97.0), (1.0, 71.0)], 9),
+            (&[(0.5, 97.0), (1.0, 71.0)], 1),
+        ];
+        for (points, degree) in cases {
+            let fitted = fit_polynomial(
+                &pts(points),
                 Variable::Roughness,
-                3,
-                Weighting::Absolute
-            )
-            .is_err()
-        );
-        assert!(
-            fit_polynomial(
-                &pts(&[(0.5, 97.0), (0.5, 90.0)]),
-                Variable::Roughness,
-                3,
-                Weighting::Absolute
-            )
-            .is_err()
-        );
-        assert!(
-            fit_polynomial(
-                &pts(&[(0.5, 97.0), (1.0, 71.0)]),
-                Variable::Roughness,
-                9,
-                Weighting::Absolute
-            )
-            .is_err()
-        );
-        assert!(
-            fit_polynomial(
-                &pts(&[(0.5, 97.0), (1.0, 71.0)]),
-                Variable::Roughness,
-                1,
-                Weighting::Absolute
-            )
-            .is_err()
-        );
+                degree,
+                Weighting::Absolute,
+            );
+            assert!(fitted.is_err(), "{points:?} at degree {degree}");
+        }
         assert!("0.5".parse::<Point>().is_err());
         assert!("x:97".parse::<Point>().is_err());
         assert!("1.5:97".parse::<Point>().is_err());

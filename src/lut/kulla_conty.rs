@@ -250,12 +250,16 @@ pub fn scale_bias(glossy: &Glossy, mu: f64, samples: u32) -> (f64, f64) {
     (scale / n, bias / n)
 }
 
-/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`, both Cycles-exact quadrature
-/// (columns in parallel).
-pub fn albedo_table(size: usize, distribution: Distribution, masking: Masking) -> Table {
+/// `E(μ_y, r_x)` (one column per roughness) and `E_avg(r_x)`, Cycles-exact quadrature,
+/// columns in parallel.
+fn albedo_columns(
+    size: usize,
+    distribution: Distribution,
+    masking: Masking,
+) -> Vec<(Glossy, Vec<f64>, f64)> {
     let integrator = AlbedoIntegrator::default();
     let n = size as f64;
-    let columns: Vec<(Vec<f64>, f64)> = (0..size)
+    (0..size)
         .into_par_iter()
         .map(|x| {
             let r = (x as f64 + 0.5) / n;
@@ -267,12 +271,18 @@ pub fn albedo_table(size: usize, distribution: Distribution, masking: Masking) -
             let e = (0..size)
                 .map(|y| integrator.directional_albedo(&glossy, (y as f64 + 0.5) / n))
                 .collect();
-            (e, integrator.average_albedo(&glossy))
+            let e_avg = integrator.average_albedo(&glossy);
+            (glossy, e, e_avg)
         })
-        .collect();
+        .collect()
+}
+
+/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`.
+pub fn albedo_table(size: usize, distribution: Distribution, masking: Masking) -> Table {
+    let columns = albedo_columns(size, distribution, masking);
     let mut data = Vec::with_capacity(size * size * 2);
     for y in 0..size {
-        for (e, e_avg) in &columns {
+        for (_, e, e_avg) in &columns {
             data.extend_from_slice(&[e[y] as f32, *e_avg as f32]);
         }
     }
@@ -292,21 +302,10 @@ pub fn kulla_conty(
     distribution: Distribution,
     masking: Masking,
 ) -> KullaConty {
-    let integrator = AlbedoIntegrator::default();
     let n = size as f64;
-    let columns: Vec<_> = (0..size)
+    let columns: Vec<_> = albedo_columns(size, distribution, masking)
         .into_par_iter()
-        .map(|x| {
-            let r = (x as f64 + 0.5) / n;
-            let glossy = Glossy {
-                distribution,
-                masking,
-                alpha: r * r,
-            };
-            let e: Vec<f64> = (0..size)
-                .map(|y| integrator.directional_albedo(&glossy, (y as f64 + 0.5) / n))
-                .collect();
-            let e_avg = integrator.average_albedo(&glossy);
+        .map(|(glossy, e, e_avg)| {
             let e_bar = column_average(&e);
             let texels: Vec<_> = (0..size)
                 .map(|y| {
