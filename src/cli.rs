@@ -72,7 +72,7 @@ pub enum Command {
     /// split-sum: the GGX "BRDF generator" texture (R = scale, G = bias; specular =
     /// F0·scale + bias). kulla-conty: for the Glossy BSDF Cycles evaluates, scale, bias,
     /// the missing multiple-scattering energy ∫f_ms cos and E_avg (RGBA), so a renderer can
-    /// add back what single scattering loses. Texel (x, y) holds roughness (x + ½)/n and
+    /// add back what single scattering loses. albedo: that BSDF's E(μ, r) and E_avg(r). Texel (x, y) holds roughness (x + ½)/n and
     /// N·V = (y + ½)/n, first row first; written as EXR, DDS (DX10) or KTX 2.0, half or float.
     Lut(crate::lut::LutArgs),
     /// Time the verify sweep as one Blender process against one process per sphere.
