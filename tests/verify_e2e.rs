@@ -88,10 +88,7 @@ fn default_coefficients_pass_in_every_blender() {
 
 #[test]
 fn seed_coefficients_fail_and_say_why() {
-    let Some((_, blender)) = common::real_blenders()
-        .into_iter()
-        .find(|(l, _)| *l == "4.5")
-    else {
+    let Some(blender) = common::real_blender("4.5") else {
         return;
     };
     let out = Command::cargo_bin("gloffuse")
@@ -124,10 +121,7 @@ fn seed_coefficients_fail_and_say_why() {
 
 #[test]
 fn refresh_measures_fits_and_verifies() {
-    let Some((_, blender)) = common::real_blenders()
-        .into_iter()
-        .find(|(l, _)| *l == "4.5")
-    else {
+    let Some(blender) = common::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
@@ -177,10 +171,7 @@ fn refresh_measures_fits_and_verifies() {
 
 #[test]
 fn verify_refuses_bad_input_before_rendering() {
-    let Some((_, blender)) = common::real_blenders()
-        .into_iter()
-        .find(|(l, _)| *l == "4.5")
-    else {
+    let Some(blender) = common::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();

@@ -66,10 +66,7 @@ fn every_ring_is_flat_in_view_and_multiscatter_modes() {
 
 #[test]
 fn the_roughness_only_gain_leaves_rings_uneven() {
-    let Some((_, blender)) = common::real_blenders()
-        .into_iter()
-        .find(|(l, _)| *l == "4.5")
-    else {
+    let Some(blender) = common::real_blender("4.5") else {
         return;
     };
     let (code, v) = verify(&blender, "roughness");
@@ -86,10 +83,7 @@ fn the_roughness_only_gain_leaves_rings_uneven() {
 
 #[test]
 fn generate_builds_the_view_and_multiscatter_groups() {
-    let Some((_, blender)) = common::real_blenders()
-        .into_iter()
-        .find(|(l, _)| *l == "4.5")
-    else {
+    let Some(blender) = common::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();

@@ -109,6 +109,14 @@ pub fn real_blenders() -> Vec<(&'static str, std::path::PathBuf)> {
     found
 }
 
+/// The real Blender labelled `label` (`"4.5"`, …), under the same rules as [`real_blenders`].
+pub fn real_blender(label: &str) -> Option<std::path::PathBuf> {
+    real_blenders()
+        .into_iter()
+        .find(|(l, _)| *l == label)
+        .map(|(_, path)| path)
+}
+
 /// Runs a Python file inside `blender` (an executable or a bpy Python) with script args.
 pub fn run_in_blender(
     blender: &std::path::Path,
