@@ -53,7 +53,7 @@ pub trait Brdf {
     /// jump of `w` where draws cross the horizon.
     ///
     /// Measured against closed forms and a 2000 × 4000 brute-force quadrature over the
-    /// hemisphere (`measure_albedo_accuracy` in tests/brdf_models.rs; white Lambert,
+    /// hemisphere (`white_furnace_two_methods` in tests/brdf_models.rs; white Lambert,
     /// Fresnel blend, Phong n ≤ 200, Ward α ≥ 0.1, Cook–Torrance α ∈ [0.1, 1.5], μ ∈ {0.1,
     /// 0.5, 1}): max |error| 2.3e-3 at n = 32, 1.8e-4 at n = 64, 2.2e-5 at n = 128,
     /// 9e-6 at n = 256 and 5e-6 at n = 512, where the largest gap is the reference's own
