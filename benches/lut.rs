@@ -13,7 +13,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use gloffuse::lut::split_sum::{split_sum, split_sum_texel_f64};
-use gloffuse::lut::{GModel, Sampling, kulla_conty};
+use gloffuse::lut::{GModel, Sampling, kulla_conty, no_progress};
 use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature};
 use rayon::prelude::*;
 use std::hint::black_box;
@@ -50,9 +50,9 @@ fn subset() -> Vec<(usize, usize)> {
 
 fn report(g_model: GModel) {
     let t = Instant::now();
-    let table = split_sum(SIZE, SAMPLES, g_model, VN);
+    let table = split_sum(SIZE, SAMPLES, g_model, VN, &no_progress);
     let elapsed = t.elapsed().as_secs_f64();
-    let reference = split_sum(SIZE, 16 * SAMPLES, g_model, VN);
+    let reference = split_sum(SIZE, 16 * SAMPLES, g_model, VN, &no_progress);
     let (err, x, y) = max_error(&table, &reference);
     println!(
         "split-sum {g_model:?} {SIZE}x{SIZE}, {SAMPLES} visible-normal samples: {elapsed:.3} s \
@@ -109,7 +109,7 @@ fn report(g_model: GModel) {
         (SAMPLES, Sampling::Classic),
     ] {
         let t = Instant::now();
-        let other = split_sum(SIZE, samples, g_model, sampling);
+        let other = split_sum(SIZE, samples, g_model, sampling, &no_progress);
         let elapsed = t.elapsed().as_secs_f64();
         let (err, x, y) = max_error(&other, &reference);
         println!(
@@ -122,7 +122,13 @@ fn lut(c: &mut Criterion) {
     report(GModel::Ue4);
     report(GModel::HeightCorrelated);
     let t = Instant::now();
-    let kc = kulla_conty::kulla_conty(64, 4096, Distribution::Ggx, Masking::HeightCorrelated);
+    let kc = kulla_conty::kulla_conty(
+        64,
+        4096,
+        Distribution::Ggx,
+        Masking::HeightCorrelated,
+        &no_progress,
+    );
     let energy =
         kc.e.iter()
             .zip(&kc.fms)
@@ -136,10 +142,18 @@ fn lut(c: &mut Criterion) {
     let mut group = c.benchmark_group("lut");
     group.sample_size(10);
     group.bench_function("split_sum_512x512_2048_ue4", |b| {
-        b.iter(|| black_box(split_sum(SIZE, SAMPLES, GModel::Ue4, VN)))
+        b.iter(|| black_box(split_sum(SIZE, SAMPLES, GModel::Ue4, VN, &no_progress)))
     });
     group.bench_function("split_sum_512x512_2048_height_correlated", |b| {
-        b.iter(|| black_box(split_sum(SIZE, SAMPLES, GModel::HeightCorrelated, VN)))
+        b.iter(|| {
+            black_box(split_sum(
+                SIZE,
+                SAMPLES,
+                GModel::HeightCorrelated,
+                VN,
+                &no_progress,
+            ))
+        })
     });
     group.finish();
 }

@@ -6,7 +6,9 @@ use clap::Parser;
 use gloffuse::Error;
 use gloffuse::blender::BlenderVersion;
 use gloffuse::lut::split_sum::{split_sum, split_sum_texel_f64};
-use gloffuse::lut::{Bits, Format, GModel, Kind, LutArgs, Sampling, Spec, Table, kulla_conty, lut};
+use gloffuse::lut::{
+    Bits, Format, GModel, Kind, LutArgs, Sampling, Spec, Table, kulla_conty, lut, no_progress,
+};
 use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature};
 use half::f16;
 use std::io::Cursor;
@@ -74,7 +76,7 @@ fn exr_reads_back_with_the_exr_crate() {
         for bits in BITS {
             let path = dir.path().join(format!("{kind:?}-{}.exr", bits.count()));
             let args = small(kind, &path, Format::Exr, bits);
-            let table = Spec::from_args(&args).unwrap().compute();
+            let table = Spec::from_args(&args).unwrap().compute(&no_progress);
             let summary = lut(&args).unwrap();
             assert_eq!(
                 summary.bytes as u64,
@@ -142,7 +144,7 @@ fn dds_reads_back_with_ddsfile() {
         for bits in BITS {
             let path = dir.path().join(format!("{kind:?}-{}.dds", bits.count()));
             let args = small(kind, &path, Format::Dds, bits);
-            let table = Spec::from_args(&args).unwrap().compute();
+            let table = Spec::from_args(&args).unwrap().compute(&no_progress);
             let summary = lut(&args).unwrap();
             let dds = Dds::read(std::fs::File::open(&path).unwrap()).unwrap();
             let expected = match (kind, bits) {
@@ -181,7 +183,7 @@ fn ktx2_reads_back_with_the_ktx2_crate() {
         for bits in BITS {
             let path = dir.path().join(format!("{kind:?}-{}.ktx2", bits.count()));
             let args = small(kind, &path, Format::Ktx, bits);
-            let table = Spec::from_args(&args).unwrap().compute();
+            let table = Spec::from_args(&args).unwrap().compute(&no_progress);
             let summary = lut(&args).unwrap();
             let bytes = std::fs::read(&path).unwrap();
             let reader = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
@@ -296,7 +298,7 @@ fn split_sum_mirror_limit_is_one() {
     let n = 256;
     for g in [GModel::Ue4, GModel::HeightCorrelated] {
         for sampling in [Sampling::VisibleNormals, Sampling::Classic] {
-            let t = split_sum(n, 256, g, sampling);
+            let t = split_sum(n, 256, g, sampling, &no_progress);
             for y in (n / 10..n).step_by(7) {
                 let nov = coord(y, n);
                 let (s, b) = (f64::from(t[y * n * 2]), f64::from(t[y * n * 2 + 1]));
@@ -319,7 +321,7 @@ fn split_sum_matches_a_converged_brute_force() {
     // the default table (visible normals, 2048 samples, f32 kernel) must agree within 1e-3.
     let n = 64;
     for g in [GModel::Ue4, GModel::HeightCorrelated] {
-        let t = split_sum(n, 2048, g, Sampling::VisibleNormals);
+        let t = split_sum(n, 2048, g, Sampling::VisibleNormals, &no_progress);
         for &(x, y) in &[
             (3, 20),
             (10, 40),
@@ -347,7 +349,7 @@ fn fast_kernels_equal_the_plain_f64_estimators() {
     let n = 32;
     for g in [GModel::Ue4, GModel::HeightCorrelated] {
         for sampling in [Sampling::VisibleNormals, Sampling::Classic] {
-            let t = split_sum(n, 333, g, sampling);
+            let t = split_sum(n, 333, g, sampling, &no_progress);
             for &(x, y) in &[(0, 0), (5, 1), (17, 9), (31, 31), (25, 3), (2, 28)] {
                 let (s, b) = split_sum_texel_f64(coord(x, n), coord(y, n), 333, g, sampling);
                 let i = (y * n + x) * 2;
@@ -369,7 +371,13 @@ fn height_correlated_scale_plus_bias_is_the_cycles_albedo() {
     // Cycles' GGX (Blender ≥ 3.6), which the albedo integrator computes by quadrature —
     // including at grazing views, where the classic estimator is off by 1e-2.
     let n = 128;
-    let t = split_sum(n, 2048, GModel::HeightCorrelated, Sampling::VisibleNormals);
+    let t = split_sum(
+        n,
+        2048,
+        GModel::HeightCorrelated,
+        Sampling::VisibleNormals,
+        &no_progress,
+    );
     let fine = AlbedoIntegrator::new(Quadrature {
         theta: 64,
         phi: 24,
@@ -405,7 +413,7 @@ fn height_correlated_scale_plus_bias_is_the_cycles_albedo() {
 fn split_sum_properties() {
     let n = 64;
     for g in [GModel::Ue4, GModel::HeightCorrelated] {
-        let t = split_sum(n, 2048, g, Sampling::VisibleNormals);
+        let t = split_sum(n, 2048, g, Sampling::VisibleNormals, &no_progress);
         for y in 0..n {
             for x in 0..n {
                 let i = (y * n + x) * 2;
@@ -475,7 +483,7 @@ fn kulla_conty_e_and_e_avg_are_the_integrators() {
     let n = 8;
     for d in Distribution::ALL {
         for masking in [Masking::Separable, Masking::HeightCorrelated] {
-            let kc = kulla_conty::kulla_conty(n, 64, d, masking);
+            let kc = kulla_conty::kulla_conty(n, 64, d, masking, &no_progress);
             for x in 0..n {
                 let glossy = Glossy {
                     distribution: d,
@@ -519,9 +527,9 @@ fn albedo_table_is_e_and_its_hemispherical_average() {
     let n = 32;
     for d in Distribution::ALL {
         for masking in [Masking::Separable, Masking::HeightCorrelated] {
-            let table = kulla_conty::albedo_table(n, d, masking);
+            let table = kulla_conty::albedo_table(n, d, masking, &no_progress);
             assert_eq!(table.channels, &["R", "G"]);
-            let kc = kulla_conty::kulla_conty(n, 4096, d, masking);
+            let kc = kulla_conty::kulla_conty(n, 4096, d, masking, &no_progress);
             let mut worst_e: f64 = 0.0;
             for x in 0..n {
                 let mut midpoint = 0.0;
@@ -574,7 +582,7 @@ fn fms_brute_force(kc: &kulla_conty::KullaConty, x: usize, y: usize) -> f64 {
 fn kulla_conty_restores_the_missing_energy() {
     let n = 32;
     for d in Distribution::ALL {
-        let kc = kulla_conty::kulla_conty(n, 4096, d, Masking::HeightCorrelated);
+        let kc = kulla_conty::kulla_conty(n, 4096, d, Masking::HeightCorrelated, &no_progress);
         for &(x, y) in &[
             (16, 0),
             (16, 8),
@@ -616,7 +624,13 @@ fn sampled_fms_estimator_converges_to_the_closed_form() {
     // DESIGN.md's estimator (f_ms · 4 N·L L·H / (N·H D) with GGX sampling) and the closed
     // form are the same integral; on a rough lobe the estimator is already close.
     let n = 16;
-    let kc = kulla_conty::kulla_conty(n, 256, Distribution::Ggx, Masking::HeightCorrelated);
+    let kc = kulla_conty::kulla_conty(
+        n,
+        256,
+        Distribution::Ggx,
+        Masking::HeightCorrelated,
+        &no_progress,
+    );
     for &(x, y) in &[(15, 3), (15, 12), (12, 8)] {
         let column: Vec<f64> = (0..n).map(|j| kc.e[j * n + x]).collect();
         let glossy = Glossy {
@@ -642,8 +656,14 @@ fn kulla_conty_ggx_scale_bias_is_the_height_correlated_split_sum() {
     args.size = Some(n as u32);
     args.samples = Some(512);
     args.blender_version = Some("4.5".parse::<BlenderVersion>().unwrap());
-    let kc = Spec::from_args(&args).unwrap().compute();
-    let ss = split_sum(n, 512, GModel::HeightCorrelated, Sampling::VisibleNormals);
+    let kc = Spec::from_args(&args).unwrap().compute(&no_progress);
+    let ss = split_sum(
+        n,
+        512,
+        GModel::HeightCorrelated,
+        Sampling::VisibleNormals,
+        &no_progress,
+    );
     for y in 0..n {
         for x in 0..n {
             for c in 0..2 {
@@ -840,4 +860,19 @@ fn summary_says_what_was_written() {
     assert!(json["seconds"].as_f64().unwrap() >= json["compute_seconds"].as_f64().unwrap());
     assert_eq!(json["channels"][0], "R: scale");
     assert!(out.exists());
+}
+
+/// `progress` is called exactly `progress_steps()` times for every kind, so a bar ends full.
+#[test]
+fn progress_counts_every_step() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    for kind in KINDS {
+        let args = small(kind, Path::new("unused.exr"), Format::Exr, Bits::Half);
+        let spec = Spec::from_args(&args).unwrap();
+        let calls = AtomicUsize::new(0);
+        spec.compute(&|| {
+            calls.fetch_add(1, Ordering::Relaxed);
+        });
+        assert_eq!(calls.into_inner(), spec.progress_steps(), "{kind:?}");
+    }
 }

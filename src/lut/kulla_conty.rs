@@ -29,8 +29,8 @@
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-use super::Table;
 use super::split_sum::{ggx_visible_normal, hammersley};
+use super::{Progress, Table};
 use crate::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking};
 
 /// The Kulla–Conty tables of one Glossy BSDF, each row-major with row y at
@@ -256,6 +256,7 @@ fn albedo_columns(
     size: usize,
     distribution: Distribution,
     masking: Masking,
+    progress: Progress,
 ) -> Vec<(Glossy, Vec<f64>, f64)> {
     let integrator = AlbedoIntegrator::default();
     let n = size as f64;
@@ -272,14 +273,21 @@ fn albedo_columns(
                 .map(|y| integrator.directional_albedo(&glossy, (y as f64 + 0.5) / n))
                 .collect();
             let e_avg = integrator.average_albedo(&glossy);
+            progress();
             (glossy, e, e_avg)
         })
         .collect()
 }
 
-/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`.
-pub fn albedo_table(size: usize, distribution: Distribution, masking: Masking) -> Table {
-    let columns = albedo_columns(size, distribution, masking);
+/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`; `progress` is called once per
+/// column.
+pub fn albedo_table(
+    size: usize,
+    distribution: Distribution,
+    masking: Masking,
+    progress: Progress,
+) -> Table {
+    let columns = albedo_columns(size, distribution, masking, progress);
     let mut data = Vec::with_capacity(size * size * 2);
     for y in 0..size {
         for (_, e, e_avg) in &columns {
@@ -295,15 +303,17 @@ pub fn albedo_table(size: usize, distribution: Distribution, masking: Masking) -
 }
 
 /// Computes the Kulla–Conty tables for `distribution` with `masking`, `size × size`
-/// texels, `samples` Hammersley points per texel (columns in parallel).
+/// texels, `samples` Hammersley points per texel (columns in parallel); `progress` is
+/// called twice per column (albedo, then scale/bias).
 pub fn kulla_conty(
     size: usize,
     samples: u32,
     distribution: Distribution,
     masking: Masking,
+    progress: Progress,
 ) -> KullaConty {
     let n = size as f64;
-    let columns: Vec<_> = albedo_columns(size, distribution, masking)
+    let columns: Vec<_> = albedo_columns(size, distribution, masking, progress)
         .into_par_iter()
         .map(|(glossy, e, e_avg)| {
             let e_bar = column_average(&e);
@@ -314,6 +324,7 @@ pub fn kulla_conty(
                     (s, b, fms_integral(mu, &e, e_bar, e_avg))
                 })
                 .collect();
+            progress();
             (e, e_avg, texels)
         })
         .collect();

@@ -52,6 +52,13 @@ use crate::Error;
 use crate::blender::BlenderVersion;
 use crate::microfacet::Distribution;
 
+/// Called from worker threads once per finished unit of work (a row or a column; see
+/// [`Spec::progress_steps`]).
+pub type Progress<'a> = &'a (dyn Fn() + Sync);
+
+/// A [`Progress`] that reports nothing.
+pub fn no_progress() {}
+
 /// The largest `--size` accepted: 8192² texels of RGBA32F is already 1 GiB.
 pub const MAX_SIZE: u32 = 8192;
 /// The largest `--samples` accepted per texel.
@@ -391,8 +398,16 @@ impl Spec {
         }
     }
 
+    /// How many times [`Spec::compute`] calls its `progress`.
+    pub fn progress_steps(&self) -> usize {
+        match *self {
+            Spec::SplitSum { size, .. } | Spec::Albedo { size, .. } => size,
+            Spec::KullaConty { size, .. } => 2 * size,
+        }
+    }
+
     /// Computes the table.
-    pub fn compute(&self) -> Table {
+    pub fn compute(&self, progress: Progress) -> Table {
         match *self {
             Spec::SplitSum {
                 size,
@@ -403,20 +418,26 @@ impl Spec {
                 width: size,
                 height: size,
                 channels: &["R", "G"],
-                data: split_sum::split_sum(size, samples, g_model, sampling),
+                data: split_sum::split_sum(size, samples, g_model, sampling, progress),
             },
             Spec::KullaConty {
                 size,
                 samples,
                 distribution,
                 blender_version,
-            } => kulla_conty::kulla_conty(size, samples, distribution, blender_version.masking())
-                .table(),
+            } => kulla_conty::kulla_conty(
+                size,
+                samples,
+                distribution,
+                blender_version.masking(),
+                progress,
+            )
+            .table(),
             Spec::Albedo {
                 size,
                 distribution,
                 blender_version,
-            } => kulla_conty::albedo_table(size, distribution, blender_version.masking()),
+            } => kulla_conty::albedo_table(size, distribution, blender_version.masking(), progress),
         }
     }
 }
@@ -481,7 +502,18 @@ pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
     // A bad destination fails before minutes of computing, not after.
     crate::output::check_destination(&args.out)?;
     let t = Instant::now();
-    let table = spec.compute();
+    // On stderr, and only when it is a terminal (indicatif hides it otherwise).
+    let bar = indicatif::ProgressBar::new(spec.progress_steps() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {percent}%, {elapsed} (ETA {eta})",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_message(format!("computing the {} table", args.kind.key()));
+    let table = spec.compute(&|| bar.inc(1));
+    bar.finish_and_clear();
     let compute_seconds = t.elapsed().as_secs_f64();
     let bytes = encode(&table, format, args.bits).map_err(|message| Error::Write {
         path: args.out.clone(),

@@ -38,7 +38,7 @@
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-use super::{GModel, Sampling};
+use super::{GModel, Progress, Sampling};
 
 /// Lanes of the inner kernels (one AVX register of f32).
 const LANES: usize = 8;
@@ -412,8 +412,14 @@ fn row<const HC: bool>(points: &Points, g_model: GModel, y: usize, size: usize) 
 }
 
 /// The split-sum table, row-major (row y = `N·V` index), two interleaved channels per texel:
-/// `[scale, bias]`. `size ≥ 1`, `samples ≥ 1`.
-pub fn split_sum(size: usize, samples: u32, g_model: GModel, sampling: Sampling) -> Vec<f32> {
+/// `[scale, bias]`. `size ≥ 1`, `samples ≥ 1`; `progress` is called once per row.
+pub fn split_sum(
+    size: usize,
+    samples: u32,
+    g_model: GModel,
+    sampling: Sampling,
+    progress: Progress,
+) -> Vec<f32> {
     let n = size as f64;
     let points = match sampling {
         Sampling::VisibleNormals => Points::Visible(Disk::new(samples)),
@@ -429,9 +435,13 @@ pub fn split_sum(size: usize, samples: u32, g_model: GModel, sampling: Sampling)
     };
     let rows: Vec<Vec<(f64, f64)>> = (0..size)
         .into_par_iter()
-        .map(|y| match g_model {
-            GModel::Ue4 => row::<false>(&points, g_model, y, size),
-            GModel::HeightCorrelated => row::<true>(&points, g_model, y, size),
+        .map(|y| {
+            let row = match g_model {
+                GModel::Ue4 => row::<false>(&points, g_model, y, size),
+                GModel::HeightCorrelated => row::<true>(&points, g_model, y, size),
+            };
+            progress();
+            row
         })
         .collect();
     let inv = 1.0 / f64::from(samples);
