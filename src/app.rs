@@ -24,7 +24,7 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
         Command::Generate(g) => {
             let out = crate::generate::generate(&g)?;
             if g.json {
-                println!("{}", serde_json::to_string_pretty(&out).expect("json"));
+                print_json(&out);
             } else {
                 if let Some(p) = &out.script {
                     println!("script: {}", p.display());
@@ -53,7 +53,7 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
                 }
             }
             if v.json {
-                println!("{}", serde_json::to_string_pretty(&report).expect("json"));
+                print_json(&report);
             } else {
                 print!("{}", crate::verify::table(&report));
             }
@@ -62,7 +62,7 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
         Command::Refresh(a) => {
             let r = crate::refresh::refresh(&a)?;
             if a.json {
-                println!("{}", serde_json::to_string_pretty(&r).expect("json"));
+                print_json(&r);
             } else {
                 print!("{}", crate::refresh::table(&r));
                 if let Some(v) = &r.verify {
@@ -77,7 +77,7 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
         Command::Lut(l) => {
             let summary = crate::lut::lut(&l)?;
             if l.json {
-                println!("{}", serde_json::to_string_pretty(&summary).expect("json"));
+                print_json(&summary);
             } else {
                 print!("{}", crate::lut::describe(&summary));
             }
@@ -95,6 +95,15 @@ pub fn run(cli: Cli) -> Result<i32, Error> {
             action: CoefficientsCommand::Show { source, json },
         } => show(source, json),
     }
+}
+
+/// Prints `value` as pretty JSON on stdout (`--json`). Our reports are plain data, so
+/// serialising them cannot fail.
+fn print_json(value: &impl serde::Serialize) {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(value).expect("reports serialise to JSON")
+    );
 }
 
 fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
@@ -155,7 +164,7 @@ fn albedo(a: AlbedoArgs) -> Result<i32, Error> {
             "directional_albedo": e,
             "average_albedo": avg,
         });
-        println!("{}", serde_json::to_string_pretty(&v).expect("json"));
+        print_json(&v);
     } else {
         println!(
             "{} roughness {} (alpha {}), Blender {} ({} masking)",
@@ -274,10 +283,7 @@ fn fit(f: FitArgs) -> Result<i32, Error> {
                 })
             })
             .collect();
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({ "fits": list })).expect("json")
-        );
+        print_json(&json!({ "fits": list }));
     } else {
         for (d, e) in &coefficients.distributions {
             print!("{}", describe_entry(d.label(), e));
@@ -462,7 +468,7 @@ fn model_albedo(a: &AlbedoArgs, model: crate::brdf::Model) -> Result<i32, Error>
             "directional_albedo": e,
             "average_albedo": avg,
         });
-        println!("{}", serde_json::to_string_pretty(&v).expect("json"));
+        print_json(&v);
     } else {
         println!(
             "{model:?} (rho {}, rs {}, exponent {}, alpha {} × {})",
