@@ -8,13 +8,14 @@
 //!   (`AlbedoIntegrator`, fine rules), which shares no code with the LUT.
 //!
 //! Goal: ≤ 0.5 s on the 2-core machine with max |error| ≤ 1e-3.
-//! Also printed: fewer samples, the classic estimator at 1024 samples (DESIGN.md §5
+//! Also printed: fewer samples, the classic estimator at 1024 samples (the textbook recipe
 //! verbatim), and the 64 × 64 Kulla–Conty GGX table.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use gloffuse::lut::split_sum::{split_sum, split_sum_texel_f64};
-use gloffuse::lut::{GModel, Sampling, kulla_conty, no_progress};
-use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature};
+use gloffuse::lut::{GModel, Sampling, kulla_conty};
+use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness};
+use gloffuse::progress::Quiet;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;
@@ -50,9 +51,9 @@ fn subset() -> Vec<(usize, usize)> {
 
 fn report(g_model: GModel) {
     let t = Instant::now();
-    let table = split_sum(SIZE, SAMPLES, g_model, VN, &no_progress);
+    let table = split_sum(SIZE, SAMPLES, g_model, VN, &Quiet);
     let elapsed = t.elapsed().as_secs_f64();
-    let reference = split_sum(SIZE, 16 * SAMPLES, g_model, VN, &no_progress);
+    let reference = split_sum(SIZE, 16 * SAMPLES, g_model, VN, &Quiet);
     let (err, x, y) = max_error(&table, &reference);
     println!(
         "split-sum {g_model:?} {SIZE}x{SIZE}, {SAMPLES} visible-normal samples: {elapsed:.3} s \
@@ -86,11 +87,11 @@ fn report(g_model: GModel) {
         let e_err = texels
             .par_iter()
             .map(|&(x, y)| {
-                let glossy = Glossy {
-                    distribution: Distribution::Ggx,
-                    masking: Masking::HeightCorrelated,
-                    alpha: coord(x) * coord(x),
-                };
+                let glossy = Glossy::new(
+                    Distribution::Ggx,
+                    Masking::HeightCorrelated,
+                    Roughness::new(coord(x)).unwrap(),
+                );
                 let e = fine.directional_albedo(&glossy, coord(y));
                 let i = (y * SIZE + x) * 2;
                 (f64::from(table[i]) + f64::from(table[i + 1]) - e).abs()
@@ -109,7 +110,7 @@ fn report(g_model: GModel) {
         (SAMPLES, Sampling::Classic),
     ] {
         let t = Instant::now();
-        let other = split_sum(SIZE, samples, g_model, sampling, &no_progress);
+        let other = split_sum(SIZE, samples, g_model, sampling, &Quiet);
         let elapsed = t.elapsed().as_secs_f64();
         let (err, x, y) = max_error(&other, &reference);
         println!(
@@ -127,7 +128,7 @@ fn lut(c: &mut Criterion) {
         4096,
         Distribution::Ggx,
         Masking::HeightCorrelated,
-        &no_progress,
+        &Quiet,
     );
     let energy =
         kc.e.iter()
@@ -142,7 +143,7 @@ fn lut(c: &mut Criterion) {
     let mut group = c.benchmark_group("lut");
     group.sample_size(10);
     group.bench_function("split_sum_512x512_2048_ue4", |b| {
-        b.iter(|| black_box(split_sum(SIZE, SAMPLES, GModel::Ue4, VN, &no_progress)))
+        b.iter(|| black_box(split_sum(SIZE, SAMPLES, GModel::Ue4, VN, &Quiet)))
     });
     group.bench_function("split_sum_512x512_2048_height_correlated", |b| {
         b.iter(|| {
@@ -151,7 +152,7 @@ fn lut(c: &mut Criterion) {
                 SAMPLES,
                 GModel::HeightCorrelated,
                 VN,
-                &no_progress,
+                &Quiet,
             ))
         })
     });

@@ -2,8 +2,12 @@
 # furnace_main.py: the "main" of gloffuse's verify job.
 #
 # Appended by the gloffuse binary after a header that defines GLOFFUSE_PARAMS
-# (the parameter document as a JSON string) and after groups_lib.py (which
-# provides build_all(params) and blender_version_string()).
+# (the parameter document as a JSON string) and after the library parts
+# compat.py, params.py, nodes.py, roughness_groups.py, view_groups.py,
+# groups.py and runtime.py. From them it uses build_all(params) (groups.py);
+# blender_version_string() and the compat_* functions, through which every
+# Blender version difference in the scene goes (compat.py); and script_args,
+# result_line and run_main (runtime.py).
 #
 # It builds a white furnace: a white world of strength 1, an orthographic
 # camera looking down -Z at a grid of white spheres (one cell per sphere, row 0
@@ -16,9 +20,8 @@
 #
 #   blender -b --factory-startup -noaudio --python-exit-code 1 --python THIS.py -- [--output OUT.exr]
 #   python3 THIS.py [--output OUT.exr]        (with the bpy module)
-# The only argument, --output, overrides furnace.output. Uses the library's
-# script_args, result_line and run_main; on any error it prints a traceback
-# and exits 1.
+# The only argument, --output, overrides furnace.output. On any error it
+# prints a traceback and exits 1 (runtime.py's run_main).
 # ---------------------------------------------------------------------------
 
 import argparse
@@ -128,81 +131,11 @@ def furnace_grid(furnace):
     return columns, rows
 
 
-# --- compatibility shim (3.x / 4.x / 5.x) ------------------------------------
-
-def compat_node_tree(id_block):
-    """The node tree of a world or material, creating it where needed.
-    3.x/4.x: node_tree is None until use_nodes is set; 5.0: always present and
-    use_nodes is deprecated, so it is only touched when there is no tree."""
-    if id_block.node_tree is None and hasattr(id_block, "use_nodes"):
-        id_block.use_nodes = True
-    if id_block.node_tree is None:
-        raise RuntimeError("%s %r has no node tree" % (type(id_block).__name__, id_block.name))
-    return id_block.node_tree
-
-
-def compat_camera_rays_only(obj):
-    """Make an object visible to camera rays only (3.0+: Object.visible_*;
-    2.9x: Object.cycles_visibility.*)."""
-    flags = {"camera": True, "diffuse": False, "glossy": False, "transmission": False,
-             "volume_scatter": False, "shadow": False}
-    if hasattr(obj, "visible_diffuse"):
-        for name, value in flags.items():
-            setattr(obj, "visible_" + name, value)
-    else:
-        visibility = obj.cycles_visibility
-        for name, value in flags.items():
-            key = "scatter" if name == "volume_scatter" else name
-            if hasattr(visibility, key):
-                setattr(visibility, key, value)
-
-
-def compat_disable_denoising(scene):
-    scene.cycles.use_denoising = False
-    for view_layer in scene.view_layers:
-        if hasattr(view_layer, "cycles") and hasattr(view_layer.cycles, "use_denoising"):
-            view_layer.cycles.use_denoising = False
-
-
-def compat_exr_settings(settings):
-    """Single-layer OpenEXR, RGBA, 32-bit float, ZIP (the exr crate reads ZIP,
-    not DWAA/DWAB). 5.0 needs media_type before file_format."""
-    if hasattr(settings, "media_type"):
-        settings.media_type = "IMAGE"
-    settings.file_format = "OPEN_EXR"
-    settings.color_mode = "RGBA"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-    if hasattr(settings, "use_zbuffer"):
-        settings.use_zbuffer = False
-    if hasattr(settings, "use_preview"):
-        settings.use_preview = False
-    if hasattr(settings, "color_management"):
-        settings.color_management = "FOLLOW_SCENE"
-
-
-def compat_uv_sphere(bm, radius):
-    # bmesh's create_uvsphere takes `radius` since 3.0 (`diameter`, which was
-    # really a radius, before).
-    try:
-        bmesh.ops.create_uvsphere(bm, u_segments=FURNACE_SPHERE_SEGMENTS,
-                                  v_segments=FURNACE_SPHERE_RINGS, radius=radius)
-    except TypeError:
-        bmesh.ops.create_uvsphere(bm, u_segments=FURNACE_SPHERE_SEGMENTS,
-                                  v_segments=FURNACE_SPHERE_RINGS, diameter=radius)
-
-
-def compat_disable_post_processing(render):
-    for name in ("use_compositing", "use_sequencer"):
-        if hasattr(render, name):
-            setattr(render, name, False)
-
-
 # --- scene ---------------------------------------------------------------------
 
 def furnace_world():
     world = bpy.data.worlds.new("Gloffuse furnace world")
-    tree = compat_node_tree(world)
+    tree = compat_node_tree(world)  # noqa: F821 -- compat.py
     tree.nodes.clear()
     background = tree.nodes.new("ShaderNodeBackground")
     background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
@@ -218,7 +151,7 @@ def furnace_sphere_mesh(radius):
     material slot is linked per object."""
     mesh = bpy.data.meshes.new("Gloffuse furnace sphere")
     bm = bmesh.new()
-    compat_uv_sphere(bm, radius)
+    compat_uv_sphere(bm, radius, FURNACE_SPHERE_SEGMENTS, FURNACE_SPHERE_RINGS)  # noqa: F821
     # The camera looks down -Z and no other ray sees a sphere, so only the
     # upper half is ever hit: drop the rest (render time grows with the
     # triangle count: Cycles syncs a separate copy of the mesh for every object
@@ -231,8 +164,7 @@ def furnace_sphere_mesh(radius):
     bm.free()
     for polygon in mesh.polygons:
         polygon.use_smooth = True
-    if hasattr(mesh, "use_auto_smooth"):
-        mesh.use_auto_smooth = False
+    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
     mesh.materials.append(None)
     mesh.update()
     return mesh
@@ -255,7 +187,7 @@ def furnace_material(index, sphere):
     else:
         label = sphere["group"]
     material = bpy.data.materials.new("Furnace %03d %s r=%g" % (index, label, sphere["roughness"]))
-    tree = compat_node_tree(material)
+    tree = compat_node_tree(material)  # noqa: F821 -- compat.py
     tree.nodes.clear()
     output = tree.nodes.new("ShaderNodeOutputMaterial")
     output.target = "ALL"
@@ -304,7 +236,7 @@ def furnace_render_settings(scene, furnace, columns, rows):
     render.pixel_aspect_y = 1.0
     render.use_border = False
     render.film_transparent = True
-    compat_disable_post_processing(render)
+    compat_disable_post_processing(render)  # noqa: F821 -- compat.py
     if furnace["threads"] > 0:
         render.threads_mode = "FIXED"
         render.threads = furnace["threads"]
@@ -317,12 +249,11 @@ def furnace_render_settings(scene, furnace, columns, rows):
     cycles.seed = furnace["seed"]
     cycles.use_animated_seed = False
     cycles.use_adaptive_sampling = False
-    if hasattr(cycles, "time_limit"):
-        cycles.time_limit = 0.0
+    compat_disable_time_limit(cycles)  # noqa: F821 -- compat.py
     # Clamping would bias the estimate; 0 disables it.
     cycles.sample_clamp_direct = 0.0
     cycles.sample_clamp_indirect = 0.0
-    compat_disable_denoising(scene)
+    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
 
     view = scene.view_settings
     scene.display_settings.display_device = "sRGB"
@@ -331,7 +262,7 @@ def furnace_render_settings(scene, furnace, columns, rows):
     view.exposure = 0.0
     view.gamma = 1.0
     view.use_curve_mapping = False
-    compat_exr_settings(render.image_settings)
+    compat_exr_settings(render.image_settings)  # noqa: F821 -- compat.py
 
 
 def furnace_scene(furnace):
@@ -354,7 +285,7 @@ def furnace_scene(furnace):
         slot = obj.material_slots[0]
         slot.link = "OBJECT"
         slot.material = furnace_material(index, sphere)
-        compat_camera_rays_only(obj)
+        compat_camera_rays_only(obj)  # noqa: F821 -- compat.py
     return scene
 
 
@@ -384,7 +315,7 @@ def render_sweep(output):
 
 
 def furnace_main():
-    args = parse_furnace_args(script_args())  # noqa: F821 -- groups_lib.py
+    args = parse_furnace_args(script_args())  # noqa: F821 -- runtime.py
     document = json.loads(GLOFFUSE_PARAMS)  # noqa: F821 -- defined by the generated header
     furnace = furnace_params(document)
     output = os.path.abspath(args.output or furnace["output"])
@@ -397,20 +328,20 @@ def furnace_main():
     if document.get("groups"):
         # A sweep of plain BSDFs only may come without groups; build_all
         # validates the generate fields (and insists on at least one group).
-        build_all(document)  # noqa: F821 -- groups_lib.py
+        build_all(document)  # noqa: F821 -- groups.py
     scene = furnace_scene(furnace)
     seconds = render_sweep(output)
 
     result = {
-        "blender_version": blender_version_string(),  # noqa: F821 -- groups_lib.py
+        "blender_version": blender_version_string(),  # noqa: F821 -- compat.py
         "output": output,
         "width": scene.render.resolution_x,
         "height": scene.render.resolution_y,
         "render_seconds": round(seconds, 3),
     }
-    print(result_line(result))  # noqa: F821 -- groups_lib.py
+    print(result_line(result))  # noqa: F821 -- runtime.py
     sys.stdout.flush()
 
 
 if __name__ == "__main__":
-    run_main(furnace_main)  # noqa: F821 -- groups_lib.py: traceback and exit 1 headless
+    run_main(furnace_main)  # noqa: F821 -- runtime.py: traceback and exit 1 headless

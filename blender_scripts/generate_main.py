@@ -7,34 +7,35 @@
 #   python3 THIS.py [--open IN.blend] [--save OUT.blend]      (with the bpy module)
 #
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
-# Needs GLOFFUSE_PARAMS (header) and the groups library (above) in the same script.
+# Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
+# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py and runtime.py.
 # ---------------------------------------------------------------------------
-import sys  # also imported by groups_lib.py; repeated so this file reads on its own
+import sys  # also imported by runtime.py; repeated so this file reads on its own
 
 
 def parse_generate_args(argv=None):
-    parser = ScriptArgumentParser(  # noqa: F821 -- groups_lib.py
+    parser = ScriptArgumentParser(  # noqa: F821 -- runtime.py
         prog="gloffuse-generate",
         description="Add or update gloffuse's brightness-correction node groups.")
     parser.add_argument("--open", metavar="IN.blend",
                         help="open this .blend file first (default: the file already open)")
     parser.add_argument("--save", metavar="OUT.blend",
                         help="save the result as this .blend file (default: do not save)")
-    return parse_script_args(parser, argv)  # noqa: F821 -- groups_lib.py
+    return parse_script_args(parser, argv)  # noqa: F821 -- runtime.py
 
 
 def generate_main():
     options = parse_generate_args()
-    params = load_params(GLOFFUSE_PARAMS)  # noqa: F821 -- header; groups_lib.py
+    params = load_params(GLOFFUSE_PARAMS)  # noqa: F821 -- header; params.py
     if options.open:
-        open_blend(options.open)  # noqa: F821 -- groups_lib.py
-    built = build_all(params)  # noqa: F821 -- groups_lib.py
-    saved = save_blend(options.save) if options.save else None  # noqa: F821
+        open_blend(options.open)  # noqa: F821 -- runtime.py
+    built = build_all(params)  # noqa: F821 -- groups.py
+    saved = save_blend(options.save) if options.save else None  # noqa: F821 -- runtime.py
     names = []
     for _spec, trees in built:
         names.extend(tree.name for tree in trees)
-    print(result_line({  # noqa: F821 -- groups_lib.py
-        "blender_version": blender_version_string(),  # noqa: F821 -- groups_lib.py
+    print(result_line({  # noqa: F821 -- runtime.py
+        "blender_version": blender_version_string(),  # noqa: F821 -- compat.py
         "groups": names,
         "saved": saved,
     }))
@@ -42,4 +43,4 @@ def generate_main():
 
 
 if __name__ == "__main__":
-    run_main(generate_main)  # noqa: F821 -- groups_lib.py: traceback, exit 1 headless
+    run_main(generate_main)  # noqa: F821 -- runtime.py: traceback, exit 1 headless

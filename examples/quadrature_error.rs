@@ -2,12 +2,10 @@
 //! quadrature sizes: the numbers behind `Quadrature::default()`.
 //! Run: `cargo run --release --example quadrature_error`
 
-#[path = "../tests/common/mod.rs"]
-mod common;
+#[path = "../tests/common/oracle.rs"]
+mod oracle;
 
-use gloffuse::microfacet::{
-    AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness,
-};
+use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness};
 use rayon::prelude::*;
 
 fn main() {
@@ -25,7 +23,7 @@ fn main() {
     }
     let reference: Vec<f64> = cases
         .par_iter()
-        .map(|(g, mu)| common::brute_force_albedo(g, *mu, 3000, 3000))
+        .map(|(g, mu)| oracle::brute_force_albedo(g, *mu, 3000, 3000))
         .collect();
     for (theta, phi) in [
         (12, 6),
@@ -46,7 +44,9 @@ fn main() {
                     e,
                     format!(
                         "{} {} alpha={:.4} mu={mu}",
-                        g.distribution, g.masking, g.alpha
+                        g.distribution(),
+                        g.masking,
+                        g.microfacet.alpha
                     ),
                 );
             }

@@ -3,17 +3,19 @@
 //! μ ≥ 0.05 (a sphere's rim pixels below that are a sliver). Run:
 //! `cargo run --release --example view_table_error`
 
-use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking};
+use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
 
 fn main() {
     let q = AlbedoIntegrator::default();
     for n in [16usize, 32, 48, 64, 96, 128] {
         let mut worst = (0.0f64, String::new());
         for d in Distribution::ALL {
-            let g = |r: f64| Glossy {
-                distribution: d,
-                masking: Masking::HeightCorrelated,
-                alpha: r * r,
+            let g = |r: f64| {
+                Glossy::new(
+                    d,
+                    Masking::HeightCorrelated,
+                    Roughness::new(r).expect("roughness in [0, 1]"),
+                )
             };
             let grid: Vec<f64> = (0..n * n)
                 .map(|k| {
@@ -58,10 +60,12 @@ fn main() {
             .collect();
         let mut worst = (0.0f64, String::new());
         for d in Distribution::ALL {
-            let g = |r: f64| Glossy {
-                distribution: d,
-                masking: Masking::HeightCorrelated,
-                alpha: r * r,
+            let g = |r: f64| {
+                Glossy::new(
+                    d,
+                    Masking::HeightCorrelated,
+                    Roughness::new(r).expect("roughness in [0, 1]"),
+                )
             };
             let pts: Vec<(f64, f64, f64)> = (0..41 * 41)
                 .map(|k| {

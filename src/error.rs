@@ -24,7 +24,8 @@ pub enum Error {
         message: String,
     },
 
-    #[error("cannot read {}: {source}", path.display())]
+    /// The io error is the cause (`source()`); the CLI prints the chain in full.
+    #[error("cannot read {}", path.display())]
     Read {
         path: PathBuf,
         source: std::io::Error,
@@ -44,7 +45,7 @@ pub enum Error {
 
     /// A rendered EXR could not be read back.
     #[error(transparent)]
-    Exr(#[from] crate::furnace::image::ExrError),
+    Exr(#[from] ExrError),
 
     /// No usable Blender: the message says where gloffuse looked and how to point at one.
     #[error("{0}")]
@@ -76,3 +77,20 @@ impl Error {
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Why an EXR could not be used; each names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ExrError {
+    #[error("EXR {} does not exist (Blender did not write it; see the log)", path.display())]
+    Missing { path: PathBuf },
+    #[error("EXR {} is truncated or corrupt: {why}", path.display())]
+    Corrupt { path: PathBuf, why: String },
+    #[error("EXR {} uses a feature gloffuse cannot read ({why}); write single-layer OPEN_EXR, 32-bit float, ZIP", path.display())]
+    Unsupported { path: PathBuf, why: String },
+    #[error("EXR {} has no {channel} channel (found: {found}); gloffuse needs R, G, B and A", path.display())]
+    MissingChannel {
+        path: PathBuf,
+        channel: &'static str,
+        found: String,
+    },
+}

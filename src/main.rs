@@ -1,14 +1,7 @@
-//! The `gloffuse` binary: parse the command line, run, map errors to exit codes.
+//! The `gloffuse` binary: the command-line layer (`cli`) over the `gloffuse` library.
 
-use clap::Parser;
+mod cli;
 
-fn main() {
-    let cli = gloffuse::cli::Cli::parse();
-    match gloffuse::app::run(cli) {
-        Ok(code) => std::process::exit(code),
-        Err(e) => {
-            eprintln!("error: {e}");
-            std::process::exit(2);
-        }
-    }
+fn main() -> std::process::ExitCode {
+    cli::main()
 }

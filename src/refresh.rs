@@ -1,20 +1,50 @@
-//! `gloffuse refresh`: coefficients measured in the user's own Blender, and `gloffuse bench`.
+//! `gloffuse refresh`: coefficients measured in the user's own Blender (render plain
+//! furnace spheres, fit them, write the file, verify it).
 
 use serde::Serialize;
-use std::time::Instant;
+use std::path::PathBuf;
 
 use crate::Error;
-use crate::blender::Blender;
-use crate::blender::script::{GenerateParams, Mode};
-use crate::cli::{BenchArgs, RefreshArgs, VerifyArgs};
-use crate::coefficients::{self, Coefficients, ColorSpace, Entry, Provenance, Target};
-use crate::fit::{Point, Variable, Weighting, fit_polynomial};
-use crate::furnace::plan::{Plan, RenderSettings};
-use crate::furnace::report::VerifyReport;
-use crate::generate::blender_from;
-use crate::microfacet::{AlbedoIntegrator, Distribution, Glossy, Roughness};
-use crate::output::{check_destination, write_atomic};
-use crate::verify::{Rendered, render, verify_with};
+use crate::blender::{Blender, BlenderOptions};
+use crate::fit::coefficients::{INTEGRATOR_DEGREE, today};
+use crate::fit::{Coefficients, FitSpec, Point, Provenance, Source, Target, Weighting};
+use crate::generate::{GenerateParams, Mode};
+use crate::measure::{AlbedoIntegrator, Distribution, Glossy, Roughness};
+use crate::output::check_destination;
+use crate::progress::Progress;
+use crate::verify::{
+    Plan, RenderSettings, Rendered, Role, VerifyOptions, VerifyReport, render, verify_with,
+};
+
+/// What `refresh` measures and where it writes the result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefreshOptions {
+    /// The coefficients file to write (atomically).
+    pub out: PathBuf,
+    /// Polynomial degree in r.
+    pub degree: usize,
+    /// How the measurement is rendered (the verify run uses verify's own samples).
+    pub render: RenderSettings,
+    /// Verify the new coefficients afterwards.
+    pub verify: bool,
+    pub blender: BlenderOptions,
+}
+
+impl Default for RefreshOptions {
+    fn default() -> Self {
+        RefreshOptions {
+            out: PathBuf::from("coefficients.json"),
+            degree: INTEGRATOR_DEGREE,
+            // 64 spp: twice verify's, so the fit's own noise stays below the check's.
+            render: RenderSettings {
+                samples: 64,
+                ..RenderSettings::default()
+            },
+            verify: true,
+            blender: BlenderOptions::default(),
+        }
+    }
+}
 
 /// Measured and predicted brightness disagreeing by more than this (relative) is a warning.
 pub const DISAGREEMENT: f64 = 0.005;
@@ -43,29 +73,23 @@ fn grid() -> Vec<f64> {
     (1..=20).map(|i| i as f64 / 20.0).collect()
 }
 
-pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
+/// Measures, fits, writes `a.out` and (unless `a.verify` is off) verifies it.
+pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed, Error> {
     // The output is checked before Blender is looked for: bad input fails fast.
     check_destination(&a.out)?;
-    let blender = blender_from(&a.blender, a.json)?;
+    let blender = a.blender.find(progress)?;
     let rs = grid();
-    let settings = RenderSettings {
-        cell: a.resolution,
-        samples: a.spp,
-        ..RenderSettings::default()
-    };
-    let plan = Plan::measure(&Distribution::ALL, &rs, settings);
+    let plan = Plan::measure(&Distribution::ALL, &rs, a.render);
     // Plain spheres need no groups; the furnace script still builds them from a preset.
-    let groups = GenerateParams::new(
-        &Coefficients::load(blender.version.preset_name())?,
-        blender.version.preset_name(),
-    );
+    let (preset, name) = Coefficients::load_or_preset(None, blender.version)?;
+    let groups = GenerateParams::new(&preset, &name);
     let Rendered { stats, .. } = render(
         &blender,
         &plan,
         &groups,
         Mode::Roughness,
         a.blender.timeout,
-        a.json,
+        progress,
     )?;
 
     let integrator = AlbedoIntegrator::default();
@@ -73,7 +97,7 @@ pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
     let mut measurements = Vec::new();
     let mut warnings = Vec::new();
     for (cell, s) in plan.cells.iter().zip(&stats) {
-        let crate::furnace::plan::Role::Uncorrected(d) = cell.role else {
+        let Role::Uncorrected(d) = cell.role else {
             continue;
         };
         let predicted =
@@ -98,10 +122,23 @@ pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
         });
     }
 
-    let degree = a.degree as usize;
-    let mut distributions = std::collections::BTreeMap::new();
-    for d in Distribution::ALL {
-        let points: Vec<Point> = measurements
+    let spec = FitSpec {
+        degree: a.degree,
+        weighting: Weighting::Relative,
+        target: Target::Mean,
+        masking,
+        provenance: Provenance {
+            source: Source::Blender,
+            blender_version: Some(blender.version_string.clone()),
+            samples: Some(format!("{} spp", a.render.samples)),
+            resolution: Some(a.render.cell),
+            points: 0,
+            date: Some(today()),
+            note: Some("mean of rendered white furnace spheres (Σ RGB / Σ alpha)".into()),
+        },
+    };
+    let points = Distribution::ALL.map(|d| {
+        let points = measurements
             .iter()
             .filter(|m| m.distribution == d)
             .map(|m| Point {
@@ -109,47 +146,23 @@ pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
                 percent: 100.0 * m.measured,
             })
             .collect();
-        let fit = fit_polynomial(&points, Variable::Roughness, degree, Weighting::Relative)?;
-        distributions.insert(
-            d,
-            Entry {
-                curve: fit.curve,
-                degree,
-                target: Target::Mean,
-                color_space: ColorSpace::Linear,
-                masking,
-                weighting: Weighting::Relative,
-                residuals: fit.residuals,
-                provenance: Provenance {
-                    source: "blender".into(),
-                    blender_version: Some(blender.version_string.clone()),
-                    samples: Some(format!("{} spp", a.spp)),
-                    resolution: Some(a.resolution),
-                    points: points.len(),
-                    date: Some(coefficients::today()),
-                    note: Some("mean of rendered white furnace spheres (Σ RGB / Σ alpha)".into()),
-                },
-            },
-        );
-    }
-    let coefficients = Coefficients {
-        format: coefficients::FORMAT.into(),
-        format_version: coefficients::FORMAT_VERSION,
-        name: format!("measured in Blender {}", blender.version_string),
-        description: format!(
+        (d, points)
+    });
+    let coefficients = Coefficients::fit(
+        format!("measured in Blender {}", blender.version_string),
+        format!(
             "Mean brightness of white glossy furnace spheres rendered in Blender {} ({} spp, {} px), fitted by gloffuse refresh; gain = 100 / f(r).",
-            blender.version_string, a.spp, a.resolution
+            blender.version_string, a.render.samples, a.render.cell
         ),
-        distributions,
-    };
-    let text = coefficients.to_json();
-    Coefficients::parse(&text, &a.out.display().to_string())?;
-    write_atomic(&a.out, text.as_bytes())?;
+        &spec,
+        points,
+    )?;
+    coefficients.write(&a.out)?;
 
-    let verify = if a.no_verify {
-        None
+    let verify = if a.verify {
+        Some(verify_new(&blender, a, progress)?)
     } else {
-        Some(verify_new(&blender, a)?)
+        None
     };
     Ok(Refreshed {
         blender_version: blender.version_string.clone(),
@@ -161,110 +174,22 @@ pub fn refresh(a: &RefreshArgs) -> Result<Refreshed, Error> {
     })
 }
 
-fn verify_new(blender: &Blender, a: &RefreshArgs) -> Result<VerifyReport, Error> {
-    let v = VerifyArgs {
+/// The verify sweep with the new file, at verify's own defaults and the measurement's
+/// resolution, with a different seed so the check sees fresh noise.
+fn verify_new(
+    blender: &Blender,
+    a: &RefreshOptions,
+    progress: &dyn Progress,
+) -> Result<VerifyReport, Error> {
+    let v = VerifyOptions {
         coefficients: Some(a.out.display().to_string()),
-        distribution: Vec::new(),
-        roughness: (0..=10)
-            .map(|i| Roughness::new(i as f64 / 10.0))
-            .collect::<Result<_, _>>()?,
-        spp: 32,
-        resolution: a.resolution,
-        tolerance: 1.0,
-        seed: 1, // not the measurement's seed: the check sees fresh noise
-        report: None,
-        mode: Mode::Roughness,
-        ring_tolerance: 1.5,
+        render: RenderSettings {
+            cell: a.render.cell,
+            seed: 1,
+            ..RenderSettings::default()
+        },
         blender: a.blender.clone(),
-        json: a.json,
+        ..VerifyOptions::default()
     };
-    Ok(verify_with(blender, &v)?.0)
-}
-
-/// The measured curve beside the prediction, then the warnings.
-pub fn table(r: &Refreshed) -> String {
-    use std::fmt::Write as _;
-    let mut s = format!(
-        "Blender {}: measured furnace sphere means vs the integrator\n",
-        r.blender_version
-    );
-    let _ = writeln!(
-        s,
-        "{:<18} {:>5} {:>9} {:>7} {:>10} {:>7}",
-        "distribution", "r", "measured", "±SE", "predicted", "diff"
-    );
-    for m in &r.measurements {
-        let _ = writeln!(
-            s,
-            "{:<18} {:>5} {:>8.2}% {:>6.2}% {:>9.2}% {:>+6.2}%",
-            m.distribution.label(),
-            m.roughness,
-            100.0 * m.measured,
-            100.0 * m.standard_error,
-            100.0 * m.predicted,
-            100.0 * (m.measured / m.predicted - 1.0)
-        );
-    }
-    for w in &r.warnings {
-        let _ = writeln!(s, "warning: {w}");
-    }
-    let _ = writeln!(s, "wrote {}", r.out);
-    s
-}
-
-#[derive(Debug, Serialize)]
-pub struct BenchResult {
-    pub spheres: usize,
-    pub one_process_seconds: f64,
-    pub per_sphere_seconds: f64,
-    pub ratio: f64,
-}
-
-/// Renders the verify sweep once as one Blender process and once as one process per sphere.
-pub fn bench(b: &BenchArgs) -> Result<BenchResult, Error> {
-    let blender = blender_from(&b.blender, false)?;
-    let preset = blender.version.preset_name();
-    let groups = GenerateParams::new(&Coefficients::load(preset)?, preset);
-    let rs: Vec<f64> = b.roughness.iter().map(|r| r.get()).collect();
-    let settings = RenderSettings {
-        samples: b.spp,
-        ..RenderSettings::default()
-    };
-    let plan = Plan::verify(&Distribution::ALL, &rs, settings, true);
-    let start = Instant::now();
-    render(
-        &blender,
-        &plan,
-        &groups,
-        Mode::Roughness,
-        b.blender.timeout,
-        true,
-    )?;
-    let one = start.elapsed().as_secs_f64();
-    eprintln!("one process: {} spheres in {one:.1} s", plan.cells.len());
-    let start = Instant::now();
-    for (i, cell) in plan.cells.iter().enumerate() {
-        let single = Plan {
-            cells: vec![cell.clone()],
-            columns: 1,
-            settings,
-        };
-        render(
-            &blender,
-            &single,
-            &groups,
-            Mode::Roughness,
-            b.blender.timeout,
-            true,
-        )?;
-        eprint!("\rone process per sphere: {}/{}", i + 1, plan.cells.len());
-    }
-    eprintln!();
-    let per = start.elapsed().as_secs_f64();
-    Ok(BenchResult {
-        spheres: plan.cells.len(),
-        one_process_seconds: one,
-        per_sphere_seconds: per,
-        ratio: per / one,
-    })
+    Ok(verify_with(blender, &v, progress)?.report)
 }

@@ -19,7 +19,8 @@
 //!   input (only the one row whose input is fine expects it), and no Blender run directory
 //!   appears in the cache (`XDG_CACHE_HOME` points at a temporary directory).
 
-use assert_cmd::Command;
+mod common;
+
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -579,8 +580,7 @@ fn run_case(case: &Case) -> Result<(), String> {
     }
     let before = snapshot(dir.path());
     let args: Vec<String> = case.args.iter().map(|a| at(a)).collect();
-    let out = Command::cargo_bin("gloffuse")
-        .unwrap()
+    let out = common::gloffuse()
         .args(&args)
         .current_dir(dir.path())
         .env("XDG_CACHE_HOME", cache.path())

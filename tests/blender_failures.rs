@@ -12,6 +12,8 @@
 //! `OUT.blend`, nor the `.gloffuse-*.blend` it is saved as first, nor `--script`'s file, nor
 //! `--report`'s directory.
 
+mod common;
+
 use std::fs;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
@@ -89,8 +91,7 @@ fn setup(version_line: &str, body: impl FnOnce(&Path) -> String) -> Setup {
 
 impl Setup {
     fn gloffuse(&self, args: &[&std::ffi::OsStr]) -> Output {
-        assert_cmd::Command::cargo_bin("gloffuse")
-            .unwrap()
+        common::gloffuse()
             .args(args)
             .arg("--blender")
             .arg(&self.blender)

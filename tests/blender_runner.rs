@@ -2,10 +2,10 @@
 //! misbehave on purpose (shell scripts written into a temporary directory), then against the
 //! real Blender 3.4 and bpy 4.5 / 5.0.
 //!
-//! Real Blenders are found through `GLOFFUSE_TEST_BLENDER_34`, `GLOFFUSE_TEST_BPY_45` and
-//! `GLOFFUSE_TEST_BPY_50` (defaults: `/usr/bin/blender`, `/opt/bpy45/bin/python`,
-//! `/opt/bpy50/bin/python`). A missing one fails the test when `CI` is set, and is skipped
-//! with a message otherwise.
+//! Real Blenders are found as `tests/common/blender.rs` says: a missing one fails the test
+//! unless `GLOFFUSE_SKIP_BLENDER_TESTS=1` asks to skip it.
+
+mod common;
 
 use std::ffi::OsString;
 use std::fs;
@@ -14,12 +14,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use gloffuse::Error;
-use gloffuse::blender::BlenderVersion;
-use gloffuse::blender::discover::{
-    Blender, BlenderKind, Environment, FindOptions, Source, Step, bpy_venv_dir, cache_dir,
-    find_blender, find_blender_in, search_plan,
-};
+use gloffuse::blender::InstallerOutput;
+use gloffuse::blender::discover::{FindOptions, Step, find_blender, find_blender_in, search_plan};
+use gloffuse::blender::environment::{Environment, bpy_venv_dir, cache_dir};
+use gloffuse::blender::probe::{Blender, BlenderKind, Source};
 use gloffuse::blender::run::{Run, command_line, run_script};
+use gloffuse::measure::BlenderVersion;
+use gloffuse::progress::Quiet;
 
 // ---------------------------------------------------------------------------------------
 // Stand-ins
@@ -65,11 +66,14 @@ fn blender_running(dir: &Path, body: &str) -> Blender {
 }
 
 fn find(program: &Path) -> Result<Blender, Error> {
-    find_blender(&FindOptions {
-        explicit: Some(program.to_path_buf()),
-        allow_provision: false,
-        quiet: true,
-    })
+    find_blender(
+        &FindOptions {
+            explicit: Some(program.to_path_buf()),
+            allow_provision: false,
+            installer_output: InstallerOutput::Log,
+        },
+        &Quiet,
+    )
 }
 
 fn run_of<'a>(blender: &'a Blender, script: &'a Path, dir: &Path, timeout: u64) -> Run<'a> {
@@ -315,7 +319,7 @@ fn explicit_paths_are_used_or_refused_never_passed_over() {
         path: Some(bin.clone().into()),
         ..Default::default()
     };
-    let shown = find_blender_in(&FindOptions::default(), &env)
+    let shown = find_blender_in(&FindOptions::default(), &env, &Quiet)
         .unwrap_err()
         .to_string();
     assert!(shown.contains("GLOFFUSE_BLENDER"), "{shown}");
@@ -455,13 +459,13 @@ fn an_unusable_blender_on_path_gives_way_to_the_cached_bpy() {
         ..Default::default()
     };
     let no_provision = FindOptions::default();
-    let shown = find_blender_in(&no_provision, &env)
+    let shown = find_blender_in(&no_provision, &env, &Quiet)
         .unwrap_err()
         .to_string();
     assert!(shown.contains("2.79"), "{shown}");
 
     let python = fake_bpy_python(&xdg.join("gloffuse/bpy-4.5/bin/python"), "4.5.4 LTS");
-    let b = find_blender_in(&no_provision, &env).unwrap();
+    let b = find_blender_in(&no_provision, &env, &Quiet).unwrap();
     assert_eq!((b.kind, b.program), (BlenderKind::PythonModule, python));
 }
 
@@ -473,7 +477,7 @@ fn nothing_found_without_provisioning_says_where_and_how() {
         home: Some(dir.path().join("home").into()),
         ..Default::default()
     };
-    let err = find_blender_in(&FindOptions::default(), &env).unwrap_err();
+    let err = find_blender_in(&FindOptions::default(), &env, &Quiet).unwrap_err();
     assert!(matches!(err, Error::BlenderNotFound(_)), "{err:?}");
     let shown = err.to_string();
     for needle in [
@@ -547,10 +551,10 @@ fn a_failed_install_leaves_nothing_that_looks_valid() {
     let (env, cache) = provisioning_env(dir.path());
     let opts = FindOptions {
         allow_provision: true,
-        quiet: true,
+        installer_output: InstallerOutput::Log,
         ..Default::default()
     };
-    let (message, log, command) = blender_error(find_blender_in(&opts, &env).unwrap_err());
+    let (message, log, command) = blender_error(find_blender_in(&opts, &env, &Quiet).unwrap_err());
     assert!(message.contains("installing bpy 4.5"), "{message}");
     assert!(message.contains("No matching distribution"), "{message}");
     assert!(command.unwrap().contains("'bpy>=4.5,<4.6'"));
@@ -568,16 +572,16 @@ fn a_successful_install_is_renamed_into_place_and_found_next_time() {
     let (env, cache) = provisioning_env(dir.path());
     let opts = FindOptions {
         allow_provision: true,
-        quiet: true,
+        installer_output: InstallerOutput::Log,
         ..Default::default()
     };
-    let b = find_blender_in(&opts, &env).unwrap();
+    let b = find_blender_in(&opts, &env, &Quiet).unwrap();
     let python = cache.join("bpy-4.5/bin/python");
     assert_eq!(b.kind, BlenderKind::PythonModule);
     assert_eq!(b.program, python);
     assert_eq!(b.version_string, "4.5.9 LTS");
     assert_eq!(leftovers(&cache), ["bpy-4.5"]);
-    let again = find_blender_in(&FindOptions::default(), &env).unwrap();
+    let again = find_blender_in(&FindOptions::default(), &env, &Quiet).unwrap();
     assert_eq!(again, b);
 }
 
@@ -587,28 +591,18 @@ fn without_python_3_11_provisioning_fails_before_touching_the_cache() {
     let (env, cache) = provisioning_env(dir.path());
     let opts = FindOptions {
         allow_provision: true,
-        quiet: true,
+        installer_output: InstallerOutput::Log,
         ..Default::default()
     };
-    let shown = find_blender_in(&opts, &env).unwrap_err().to_string();
+    let shown = find_blender_in(&opts, &env, &Quiet)
+        .unwrap_err()
+        .to_string();
     assert!(shown.contains("CPython 3.11"), "{shown}");
     assert!(!cache.exists());
 }
 
 // ---------------------------------------------------------------------------------------
 // Real Blenders
-
-/// The Blender named by `var` (or `default`); `None` (skip) if it is missing outside CI.
-fn real(var: &str, default: &str) -> Option<PathBuf> {
-    let path = std::env::var_os(var).map_or_else(|| PathBuf::from(default), PathBuf::from);
-    if path.exists() {
-        return Some(path);
-    }
-    let why = format!("{} not found (set {var})", path.display());
-    assert!(std::env::var_os("CI").is_none(), "CI: {why}");
-    eprintln!("skipped: {why}");
-    None
-}
 
 const PROBE_SCRIPT: &str = r#"
 import json, sys
@@ -622,8 +616,8 @@ sys.stdout.write("GLOFFUSE_RESULT " + json.dumps(result) + "\n")
 sys.stdout.flush()
 "#;
 
-fn check_real(var: &str, default: &str, kind: BlenderKind, major: u32, minor: u32) {
-    let Some(program) = real(var, default) else {
+fn check_real(label: &str, kind: BlenderKind, major: u32, minor: u32) {
+    let Some(program) = common::blender::real_blender(label) else {
         return;
     };
     let blender = find(&program).unwrap();
@@ -663,33 +657,15 @@ fn check_real(var: &str, default: &str, kind: BlenderKind, major: u32, minor: u3
 
 #[test]
 fn real_blender_3_4() {
-    check_real(
-        "GLOFFUSE_TEST_BLENDER_34",
-        "/usr/bin/blender",
-        BlenderKind::Binary,
-        3,
-        4,
-    );
+    check_real("3.4", BlenderKind::Binary, 3, 4);
 }
 
 #[test]
 fn real_bpy_4_5() {
-    check_real(
-        "GLOFFUSE_TEST_BPY_45",
-        "/opt/bpy45/bin/python",
-        BlenderKind::PythonModule,
-        4,
-        5,
-    );
+    check_real("4.5", BlenderKind::PythonModule, 4, 5);
 }
 
 #[test]
 fn real_bpy_5_0() {
-    check_real(
-        "GLOFFUSE_TEST_BPY_50",
-        "/opt/bpy50/bin/python",
-        BlenderKind::PythonModule,
-        5,
-        0,
-    );
+    check_real("5.0", BlenderKind::PythonModule, 5, 0);
 }

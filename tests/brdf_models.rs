@@ -1,9 +1,9 @@
-//! The classic BRDFs (`gloffuse::brdf`) against independent oracles: reciprocity, the
+//! The classic BRDFs (`gloffuse::measure::brdf`) against independent oracles: reciprocity, the
 //! horizon, the sampler against its own pdf, brute-force quadrature over the sphere with far
 //! more points than the sampler uses, and closed-form albedos derived in the comments.
 
 use glam::DVec3;
-use gloffuse::brdf::{
+use gloffuse::measure::brdf::{
     Brdf, CookTorrance, FresnelBlendDiffuse, Lambert, Model, ModelParams, ModifiedPhong, Shadowing,
     Ward, model_albedo,
 };

@@ -1,14 +1,13 @@
 //! The `gloffuse` binary driven as a user would, including bad input: every bad input must
 //! exit 2 with a message naming the input, never panic, and never leave a file behind.
 
-use assert_cmd::Command;
+mod common;
+
 use predicates::prelude::*;
 use serde_json::Value;
 use std::f64::consts::LN_2;
 
-fn gloffuse() -> Command {
-    Command::cargo_bin("gloffuse").unwrap()
-}
+use common::gloffuse;
 
 fn json_of(args: &[&str]) -> Value {
     let out = gloffuse()
@@ -36,6 +35,36 @@ fn help_and_version() {
         .assert()
         .success()
         .stdout(predicate::str::contains("view cosine"));
+}
+
+/// A stdout whose reader is already gone (`gloffuse … | true`): every write fails with
+/// EPIPE. The program must end quietly with exit code 0, as ripgrep does, not panic.
+#[test]
+fn a_closed_stdout_ends_quietly_with_exit_0() {
+    use std::os::fd::{FromRawFd, OwnedFd};
+    let cases: [&[&str]; 5] = [
+        &["coefficients", "show", "blender-4", "--json"],
+        &["coefficients", "show", "seed"],
+        &["albedo", "-d", "ggx", "-r", "1", "--json"],
+        &["fit", "-d", "ggx", "--point", "0.5:85", "--point", "1:59"],
+        &["albedo", "--model", "lambert"],
+    ];
+    for args in cases {
+        let mut fds = [0; 2];
+        // SAFETY: pipe() fills two new descriptors; each is owned exactly once below.
+        assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+        let (reader, writer) =
+            unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) };
+        drop(reader);
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("gloffuse"))
+            .args(args)
+            .stdout(writer)
+            .output()
+            .expect("gloffuse starts");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+        assert!(stderr.is_empty(), "{args:?} printed: {stderr}");
+    }
 }
 
 #[test]

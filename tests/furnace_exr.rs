@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use exr::prelude::{
     Blocks, Compression, Encoding, Image, LineOrder, SpecificChannels, Vec2, WritableImage,
 };
-use gloffuse::furnace::image::{ExrError, Rgba, read_rgba};
+use gloffuse::verify::image::{ExrError, Rgba, read_rgba};
 use tempfile::TempDir;
 
 /// Fixture size: 16 rows fit one ZIP16 block (and one block of every other compression),

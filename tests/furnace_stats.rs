@@ -10,8 +10,8 @@
 
 use std::f64::consts::PI;
 
-use gloffuse::furnace::image::Rgba;
-use gloffuse::furnace::stats::{RINGS, SphereStats, sphere_stats};
+use gloffuse::verify::image::Rgba;
+use gloffuse::verify::stats::{RINGS, SphereStats, sphere_stats};
 
 const CELL: usize = 64;
 const RADIUS_FRACTION: f64 = 0.9;

@@ -5,9 +5,8 @@
 
 mod common;
 
-use assert_cmd::Command;
-use gloffuse::blender::script::{correction_group_name, shader_group_name};
-use gloffuse::coefficients::Coefficients;
+use gloffuse::fit::Coefficients;
+use gloffuse::generate::{correction_group_name, shader_group_name};
 use serde_json::{Value, json};
 
 const PROBES: [f64; 6] = [0.0, 0.2, 0.5, 0.75, 1.0, 1.5];
@@ -36,7 +35,7 @@ fn generated_blend_works_in_every_blender() {
         env!("CARGO_MANIFEST_DIR"),
         "/tests/blender/check_generated.py"
     );
-    for (label, blender) in common::real_blenders() {
+    for (label, blender) in common::blender::real_blenders() {
         let dir = tempfile::tempdir().unwrap();
         let sub = dir.path().join("a dir é 'q\"");
         std::fs::create_dir(&sub).unwrap();
@@ -47,8 +46,7 @@ fn generated_blend_works_in_every_blender() {
         } else {
             "blender-4"
         };
-        let out = Command::cargo_bin("gloffuse")
-            .unwrap()
+        let out = common::gloffuse()
             .args(["generate", "--json", "--blend"])
             .arg(&blend)
             .arg("--script")
@@ -78,7 +76,7 @@ fn generated_blend_works_in_every_blender() {
         let expect = dir.path().join("expect.json");
         std::fs::write(&expect, expectations(preset).to_string()).unwrap();
         let result = dir.path().join("result.json");
-        let run = common::run_in_blender(
+        let run = common::blender::run_in_blender(
             &blender,
             checker.as_ref(),
             &[
@@ -108,14 +106,13 @@ fn generated_blend_works_in_every_blender() {
 
 #[test]
 fn into_replaces_groups_in_place_and_keeps_a_backup() {
-    let Some(blender) = common::real_blender("4.5") else {
+    let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
     let blend = dir.path().join("scene.blend");
     let run = |coefficients: &str| {
-        Command::cargo_bin("gloffuse")
-            .unwrap()
+        common::gloffuse()
             .args(["generate", "--coefficients", coefficients, "--into"])
             .arg(&blend)
             .arg("--blender")
@@ -128,8 +125,7 @@ fn into_replaces_groups_in_place_and_keeps_a_backup() {
         .code(2)
         .stderr(predicates::str::contains("an existing .blend file"));
     assert!(!blend.exists());
-    Command::cargo_bin("gloffuse")
-        .unwrap()
+    common::gloffuse()
         .args(["generate", "--coefficients", "seed", "--blend"])
         .arg(&blend)
         .arg("--blender")

@@ -1,8 +1,8 @@
 //! Generated Python without Blender: byte-stable, parses, and no parameter text can become
 //! code (checked by CPython's own parser on arbitrary Unicode, see check_script.py).
 
-use gloffuse::blender::script::{GENERATE_MAIN, GenerateParams, assemble};
-use gloffuse::coefficients::Coefficients;
+use gloffuse::fit::Coefficients;
+use gloffuse::generate::{GenerateParams, Job, assemble};
 use proptest::prelude::*;
 use std::path::Path;
 use std::process::Command;
@@ -14,7 +14,7 @@ fn seed_params() -> GenerateParams {
 /// Runs check_script.py on (script, expected parameters) pairs against a benign reference.
 fn check_scripts(dir: &Path, cases: &[(String, serde_json::Value)]) {
     let reference = dir.join("reference.py");
-    std::fs::write(&reference, assemble(&seed_params(), GENERATE_MAIN)).unwrap();
+    std::fs::write(&reference, assemble(&seed_params(), Job::Generate)).unwrap();
     let mut cmd = Command::new("python3");
     cmd.arg(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -43,8 +43,8 @@ fn check_scripts(dir: &Path, cases: &[(String, serde_json::Value)]) {
 
 #[test]
 fn golden_seed_script_is_byte_stable() {
-    let a = assemble(&seed_params(), GENERATE_MAIN);
-    let b = assemble(&seed_params(), GENERATE_MAIN);
+    let a = assemble(&seed_params(), Job::Generate);
+    let b = assemble(&seed_params(), Job::Generate);
     assert_eq!(a, b);
     let golden_path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/generate-seed.py");
     if std::env::var_os("GLOFFUSE_BLESS").is_some() {
@@ -82,7 +82,7 @@ fn hostile_text_round_trips_and_never_becomes_code() {
                 g.shader_group = format!("Gloffuse {text}");
             }
             (
-                assemble(&p, GENERATE_MAIN),
+                assemble(&p, Job::Generate),
                 serde_json::to_value(&p).unwrap(),
             )
         })
@@ -102,7 +102,7 @@ proptest! {
                 p.coefficients_source = pair[0].clone();
                 p.groups[0].description = pair[1].clone();
                 p.groups[1].correction_group = pair[0].clone();
-                (assemble(&p, GENERATE_MAIN), serde_json::to_value(&p).unwrap())
+                (assemble(&p, Job::Generate), serde_json::to_value(&p).unwrap())
             })
             .collect();
         check_scripts(dir.path(), &cases);

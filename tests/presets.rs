@@ -1,10 +1,10 @@
 //! The shipped presets: the seed reproduces its published numbers, and the linear presets
 //! keep the gain within 0.1 % of 1/E_avg on [0, 1] for their Blender family.
 
-use gloffuse::blender::BlenderVersion;
-use gloffuse::coefficients::{Coefficients, Target};
 use gloffuse::fit::Weighting;
-use gloffuse::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
+use gloffuse::fit::{Coefficients, Target};
+use gloffuse::measure::BlenderVersion;
+use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
 
 #[test]
 fn seed_preset_holds_the_hand_made_cubics() {

@@ -5,12 +5,12 @@
 
 use std::path::{Path, PathBuf};
 
-use gloffuse::furnace::image::Rgba;
-use gloffuse::furnace::plan::{Plan, RenderSettings};
-use gloffuse::furnace::png::{PLOT_SIZE, brightness_plot, contact_sheet, sheet_labels};
-use gloffuse::furnace::report::{ReferenceSphere, RenderInfo, Row, VerifyReport};
-use gloffuse::furnace::stats::{SphereStats, sphere_stats};
-use gloffuse::microfacet::Distribution;
+use gloffuse::measure::Distribution;
+use gloffuse::report::png::{PLOT_SIZE, brightness_plot, contact_sheet, sheet_labels};
+use gloffuse::verify::image::Rgba;
+use gloffuse::verify::plan::{Plan, RenderSettings};
+use gloffuse::verify::stats::{SphereStats, sphere_stats};
+use gloffuse::verify::{ReferenceSphere, RenderInfo, Row, VerifyReport};
 
 const CELL: usize = 16;
 const RADIUS_FRACTION: f64 = 0.9;
@@ -136,7 +136,7 @@ fn small_report(img: &Rgba) -> VerifyReport {
         })
         .collect();
     VerifyReport {
-        mode: gloffuse::blender::script::Mode::Roughness,
+        mode: gloffuse::generate::Mode::Roughness,
         ring_tolerance_percent: 1.5,
         coefficients: "cycles-4.x".into(),
         render: render_info(CELL, 3, 3),
@@ -336,7 +336,7 @@ fn full_sweep_sheet_and_plot() {
     let roughness: Vec<f64> = (0..=10).map(|i| i as f64 / 10.0).collect();
     let settings = RenderSettings::default();
     let cell = settings.cell as usize;
-    let plan = Plan::verify(&Distribution::ALL, &roughness, settings, true);
+    let plan = Plan::verify(&Distribution::ALL, &roughness, settings);
     let (row_labels, column_labels) = sheet_labels(&plan);
     assert_eq!(row_labels.len(), 7);
     assert_eq!(row_labels[4], "Ashikhmin-Shirley uncorrected");
@@ -395,7 +395,7 @@ fn full_sweep_sheet_and_plot() {
         })
         .collect();
     let report = VerifyReport {
-        mode: gloffuse::blender::script::Mode::Roughness,
+        mode: gloffuse::generate::Mode::Roughness,
         ring_tolerance_percent: 1.5,
         coefficients: "presets/cycles-4.x.json".into(),
         render: render_info(cell, columns, 7),

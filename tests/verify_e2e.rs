@@ -6,12 +6,10 @@
 
 mod common;
 
-use assert_cmd::Command;
 use serde_json::Value;
 
 fn verify_json(blender: &std::path::Path, extra: &[&str]) -> (i32, Value, String) {
-    let out = Command::cargo_bin("gloffuse")
-        .unwrap()
+    let out = common::gloffuse()
         .arg("verify")
         .arg("--blender")
         .arg(blender)
@@ -26,7 +24,7 @@ fn verify_json(blender: &std::path::Path, extra: &[&str]) -> (i32, Value, String
 
 #[test]
 fn default_coefficients_pass_in_every_blender() {
-    for (label, blender) in common::real_blenders() {
+    for (label, blender) in common::blender::real_blenders() {
         let dir = tempfile::tempdir().unwrap();
         let report = dir.path().join("report dir é");
         let (code, v, stderr) =
@@ -81,18 +79,17 @@ fn default_coefficients_pass_in_every_blender() {
             );
         }
         // The report's EXR reads back with the same statistics the report holds.
-        let img = gloffuse::furnace::image::read_rgba(&report.join("sweep.exr")).unwrap();
+        let img = gloffuse::verify::image::read_rgba(&report.join("sweep.exr")).unwrap();
         assert_eq!((img.width, img.height), (11 * 64, 7 * 64));
     }
 }
 
 #[test]
 fn seed_coefficients_fail_and_say_why() {
-    let Some(blender) = common::real_blender("4.5") else {
+    let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
-    let out = Command::cargo_bin("gloffuse")
-        .unwrap()
+    let out = common::gloffuse()
         .args([
             "verify",
             "--coefficients",
@@ -121,13 +118,12 @@ fn seed_coefficients_fail_and_say_why() {
 
 #[test]
 fn refresh_measures_fits_and_verifies() {
-    let Some(blender) = common::real_blender("4.5") else {
+    let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("measured.json");
-    let run = Command::cargo_bin("gloffuse")
-        .unwrap()
+    let run = common::gloffuse()
         .args([
             "refresh",
             "--json",
@@ -161,8 +157,7 @@ fn refresh_measures_fits_and_verifies() {
     assert!(p["blender_version"].as_str().unwrap().starts_with("4.5"));
     assert_eq!(p["samples"], "32 spp");
     // The file is a valid coefficients file for every other command.
-    Command::cargo_bin("gloffuse")
-        .unwrap()
+    common::gloffuse()
         .args(["coefficients", "show"])
         .arg(&out)
         .assert()
@@ -171,7 +166,7 @@ fn refresh_measures_fits_and_verifies() {
 
 #[test]
 fn verify_refuses_bad_input_before_rendering() {
-    let Some(blender) = common::real_blender("4.5") else {
+    let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
@@ -213,8 +208,7 @@ fn verify_refuses_bad_input_before_rendering() {
         ),
     ];
     for (args, fragment) in cases {
-        Command::cargo_bin("gloffuse")
-            .unwrap()
+        common::gloffuse()
             .arg("verify")
             .args(&args)
             .arg("--blender")

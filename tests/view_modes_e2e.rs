@@ -4,12 +4,10 @@
 
 mod common;
 
-use assert_cmd::Command;
 use serde_json::Value;
 
 fn verify(blender: &std::path::Path, mode: &str) -> (i32, Value) {
-    let out = Command::cargo_bin("gloffuse")
-        .unwrap()
+    let out = common::gloffuse()
         .args([
             "verify",
             "--json",
@@ -37,7 +35,7 @@ fn worst_ring(row: &Value) -> f64 {
 
 #[test]
 fn every_ring_is_flat_in_view_and_multiscatter_modes() {
-    for (label, blender) in common::real_blenders() {
+    for (label, blender) in common::blender::real_blenders() {
         for mode in ["view", "multiscatter"] {
             let (code, v) = verify(&blender, mode);
             assert_eq!(code, 0, "Blender {label} --mode {mode}: {v:#}");
@@ -66,7 +64,7 @@ fn every_ring_is_flat_in_view_and_multiscatter_modes() {
 
 #[test]
 fn the_roughness_only_gain_leaves_rings_uneven() {
-    let Some(blender) = common::real_blender("4.5") else {
+    let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
     let (code, v) = verify(&blender, "roughness");
@@ -83,12 +81,11 @@ fn the_roughness_only_gain_leaves_rings_uneven() {
 
 #[test]
 fn generate_builds_the_view_and_multiscatter_groups() {
-    let Some(blender) = common::real_blender("4.5") else {
+    let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::cargo_bin("gloffuse")
-        .unwrap()
+    let out = common::gloffuse()
         .args([
             "generate",
             "--json",

@@ -1,12 +1,65 @@
-//! Everything about Blender itself: versions, finding (or installing) it, and running
-//! scripts in it headless.
+//! Infrastructure: running Blender. Layered bottom-up: `process` (spawning with process
+//! groups, timeouts and logs), `environment` (what the search reads), `probe` (is this a
+//! Blender, which version), `provision` (install bpy), `discover` (the search), `run`
+//! (a script run headless, its result line read back) and `runs` (where runs keep their
+//! files).
 
 pub mod discover;
+pub mod environment;
+pub mod probe;
+pub mod process;
+pub mod provision;
 pub mod run;
 pub mod runs;
-pub mod script;
-pub mod version;
 
-pub use discover::{Blender, BlenderKind, FindOptions, find_blender};
+pub use discover::{FindOptions, find_blender};
+pub use probe::{Blender, BlenderKind, probe};
+pub use provision::InstallerOutput;
 pub use run::{Run, RunOutput, command_line, run_script};
-pub use version::BlenderVersion;
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use crate::Error;
+use crate::progress::Progress;
+
+/// Where Blender comes from and how long it may run: shared by every command that runs it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlenderOptions {
+    /// A Blender executable, or a Python interpreter that imports bpy (else the search of
+    /// [`find_blender`]).
+    pub program: Option<PathBuf>,
+    /// Install bpy into the cache when no Blender is found.
+    pub provision: bool,
+    /// Where pip's output goes if bpy is installed.
+    pub installer_output: InstallerOutput,
+    /// Kill Blender (and its children) after this long.
+    pub timeout: Duration,
+}
+
+impl Default for BlenderOptions {
+    fn default() -> Self {
+        BlenderOptions {
+            program: None,
+            provision: true,
+            installer_output: InstallerOutput::Log,
+            timeout: Duration::from_secs(600),
+        }
+    }
+}
+
+impl BlenderOptions {
+    /// Finds Blender as the options say and announces which one is used.
+    pub fn find(&self, progress: &dyn Progress) -> Result<Blender, Error> {
+        let blender = find_blender(
+            &FindOptions {
+                explicit: self.program.clone(),
+                allow_provision: self.provision,
+                installer_output: self.installer_output,
+            },
+            progress,
+        )?;
+        progress.notice(&format!("using {}", blender.describe()));
+        Ok(blender)
+    }
+}

@@ -10,8 +10,8 @@ pub const KEEP: usize = 20;
 
 /// Makes `<cache>/gloffuse/runs/<job>-<time>-<pid>/` and prunes old runs.
 pub fn new_run_dir(job: &str) -> Result<PathBuf, Error> {
-    let env = super::discover::Environment::from_process();
-    let root = super::discover::cache_dir(&env)
+    let env = super::environment::Environment::from_process();
+    let root = super::environment::cache_dir(&env)
         .unwrap_or_else(|| std::env::temp_dir().join("gloffuse"))
         .join("runs");
     let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())

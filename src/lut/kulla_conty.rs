@@ -20,18 +20,20 @@
 //!   `--g-model height-correlated`. At run time, `F0 · R + G` is the single-scattering
 //!   response with Schlick's Fresnel.
 //! * **B** = `∫ f_ms(μ, μi) cosθi dωi = (1 − E(μ)) (1 − Ē) / (1 − E_avg)`, in closed form
-//!   ([`fms_integral`]; `Ē` is the table's own exact average of E). DESIGN.md integrates it
-//!   with the same importance sampling as R and G (`f_ms · 4 · N·L · L·H / (N·H · D)`,
+//!   ([`fms_integral`]; `Ē` is the table's own exact average of E). The textbook recipe
+//!   integrates it with the same importance sampling as R and G (`f_ms · 4 · N·L · L·H / (N·H · D)`,
 //!   [`fms_sampled`]); that converges to the same number, but far too slowly.
 //! * **A** = `E_avg(r)`, the same in every row of a column; with a coloured Fresnel the
 //!   multiple-scattering term is `F_avg E_avg / (1 − F_avg (1 − E_avg)) · B`.
 
+use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-use super::split_sum::{ggx_visible_normal, hammersley};
-use super::{Progress, Table};
-use crate::microfacet::{AlbedoIntegrator, Distribution, Glossy, Masking};
+use super::Table;
+use super::split_sum::{disk_point, hammersley};
+use crate::measure::{AlbedoGrid, AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
+use crate::progress::Progress;
 
 /// The Kulla–Conty tables of one Glossy BSDF, each row-major with row y at
 /// `μ = (y + ½)/size` and column x at `r = (x + ½)/size`.
@@ -73,40 +75,6 @@ impl KullaConty {
             height: n,
             channels: &["R", "G", "B", "A"],
             data,
-        }
-    }
-}
-
-/// The half vector's polar angle `(cos θh, sin θh)` for CDF value `v` of the sampling
-/// density (the inverse CDFs of Cycles' samplers).
-pub fn sample_polar(glossy: &Glossy, v: f64) -> (f64, f64) {
-    let a2 = glossy.alpha * glossy.alpha;
-    let from_tan2 = |t2: f64| {
-        let c2 = 1.0 / (1.0 + t2);
-        (c2.sqrt(), (t2 * c2).sqrt())
-    };
-    match glossy.distribution {
-        // tan²θ = α² v/(1 − v)
-        Distribution::Ggx => super::split_sum::ggx_polar(glossy.alpha, v),
-        // tan²θ = −α² ln(1 − v)
-        Distribution::Beckmann => from_tan2(-a2 * (-v).ln_1p()),
-        // cosθ = (1 − v)^(1/(n + 1))
-        Distribution::AshikhminShirley => {
-            let n = glossy.ashikhmin_shirley_exponent();
-            let log_cos = (-v).ln_1p() / (n + 1.0);
-            (log_cos.exp(), (-(2.0 * log_cos).exp_m1()).max(0.0).sqrt())
-        }
-    }
-}
-
-/// The sampling density of the half vector per unit solid angle at `cos θh`:
-/// `D(h) cosθh` for the microfacet models, `(n + 1)/(2π) cosⁿθh` for Ashikhmin–Shirley.
-pub fn pdf_h(glossy: &Glossy, cos_h: f64) -> f64 {
-    match glossy.distribution {
-        Distribution::Ggx | Distribution::Beckmann => glossy.d(cos_h) * cos_h,
-        Distribution::AshikhminShirley => {
-            let n = glossy.ashikhmin_shirley_exponent();
-            (n + 1.0) / (2.0 * PI) * cos_h.powf(n)
         }
     }
 }
@@ -167,7 +135,7 @@ pub fn fms_integral(mu: f64, e_column: &[f64], e_bar: f64, e_avg: f64) -> f64 {
     }
 }
 
-/// DESIGN.md's estimator of channel B, kept for comparison: the f_ms lobe integrated with
+/// The textbook estimator of channel B, kept for comparison: the f_ms lobe integrated with
 /// the distribution's own half-vector sampling, `(1/N) Σ f_ms · 4 N·L V·H / pdf(h)` over
 /// the samples with `V·H > 0` and `N·L > 0` (`pdf(h) = D N·H` for the microfacet models).
 /// It converges to [`fms_integral`], but slowly: a narrow lobe's samples rarely reach the
@@ -182,12 +150,12 @@ pub fn fms_sampled(glossy: &Glossy, mu: f64, samples: u32, e_column: &[f64], e_a
     let mut fms = 0.0;
     for i in 0..samples {
         let (u, v) = hammersley(i, samples);
-        let (cos_h, sin_h) = sample_polar(glossy, v);
-        let o_dot_h = sin_o * sin_h * (2.0 * PI * u).cos() + mu * cos_h;
-        let cos_i = 2.0 * o_dot_h * cos_h - mu;
+        let h = glossy.microfacet.sample_polar(v);
+        let o_dot_h = sin_o * h.sin * (2.0 * PI * u).cos() + mu * h.cos;
+        let cos_i = 2.0 * o_dot_h * h.cos - mu;
         if o_dot_h > 0.0 && cos_i > 0.0 {
             let f_ms = k * missing(interpolate(e_column, cos_i));
-            fms += f_ms * cos_i * 4.0 * o_dot_h / pdf_h(glossy, cos_h);
+            fms += f_ms * cos_i * 4.0 * o_dot_h / glossy.microfacet.pdf_h(h.cos);
         }
     }
     fms / f64::from(samples)
@@ -203,41 +171,23 @@ pub fn fms_sampled(glossy: &Glossy, mu: f64, samples: u32, e_column: &[f64], e_a
 /// (Ashikhmin–Shirley flips a back-facing h after taking V·H, as Cycles does).
 pub fn scale_bias(glossy: &Glossy, mu: f64, samples: u32) -> (f64, f64) {
     let sin_o = (1.0 - mu * mu).max(0.0).sqrt();
-    let v = [sin_o, 0.0, mu];
     let (mut scale, mut bias) = (0.0, 0.0);
     for i in 0..samples {
-        let (w, voh) = match glossy.distribution {
+        let (w, voh) = match glossy.distribution() {
             Distribution::Ggx => {
-                let h = ggx_visible_normal(glossy.alpha, v, i, samples);
-                let voh = v[0] * h[0] + v[2] * h[2];
-                let cos_i = 2.0 * voh * h[2] - mu;
-                if cos_i > 0.0 {
-                    (glossy.g2(mu, cos_i) * (1.0 + glossy.lambda(mu)), voh)
-                } else {
-                    (0.0, voh)
-                }
+                let v = DVec3::new(sin_o, 0.0, mu);
+                let h = glossy
+                    .microfacet
+                    .sample_visible_normal(v, disk_point(i, samples));
+                let voh = v.x * h.x + v.z * h.z;
+                let cos_i = 2.0 * voh * h.z - mu;
+                (glossy.visible_normal_weight(mu, cos_i), voh)
             }
-            Distribution::Beckmann => {
+            Distribution::Beckmann | Distribution::AshikhminShirley => {
                 let (u, v) = hammersley(i, samples);
-                let (cos_h, sin_h) = sample_polar(glossy, v);
-                let voh = sin_o * sin_h * (2.0 * PI * u).cos() + mu * cos_h;
-                let cos_i = 2.0 * voh * cos_h - mu;
-                if cos_i > 0.0 {
-                    (glossy.g2(mu, cos_i) * voh / (mu * cos_h), voh)
-                } else {
-                    (0.0, voh)
-                }
-            }
-            Distribution::AshikhminShirley => {
-                let (u, v) = hammersley(i, samples);
-                let (cos_h, sin_h) = sample_polar(glossy, v);
-                let voh = (sin_o * sin_h * (2.0 * PI * u).cos() + mu * cos_h).abs();
-                let cos_i = 2.0 * voh * cos_h - mu;
-                if cos_i > 0.0 {
-                    (cos_i / cos_i.max(mu), voh)
-                } else {
-                    (0.0, voh)
-                }
+                let h = glossy.microfacet.sample_polar(v);
+                let sample = glossy.half_vector_sample(mu, sin_o, h, (2.0 * PI * u).cos());
+                (sample.weight, sample.o_dot_h)
             }
         };
         if w > 0.0 {
@@ -250,48 +200,31 @@ pub fn scale_bias(glossy: &Glossy, mu: f64, samples: u32) -> (f64, f64) {
     (scale / n, bias / n)
 }
 
-/// `E(μ_y, r_x)` (one column per roughness) and `E_avg(r_x)`, Cycles-exact quadrature,
-/// columns in parallel.
-fn albedo_columns(
+/// `E(μ_y, r_x)` and `E_avg(r_x)` at the table's pixel centres, Cycles-exact quadrature.
+fn albedo_grid(
     size: usize,
     distribution: Distribution,
     masking: Masking,
-    progress: Progress,
-) -> Vec<(Glossy, Vec<f64>, f64)> {
-    let integrator = AlbedoIntegrator::default();
-    let n = size as f64;
-    (0..size)
-        .into_par_iter()
-        .map(|x| {
-            let r = (x as f64 + 0.5) / n;
-            let glossy = Glossy {
-                distribution,
-                masking,
-                alpha: r * r,
-            };
-            let e = (0..size)
-                .map(|y| integrator.directional_albedo(&glossy, (y as f64 + 0.5) / n))
-                .collect();
-            let e_avg = integrator.average_albedo(&glossy);
-            progress();
-            (glossy, e, e_avg)
-        })
-        .collect()
+    progress: &dyn Progress,
+) -> AlbedoGrid {
+    let centres = Roughness::pixel_centres(size);
+    let mus: Vec<f64> = centres.iter().map(|mu| mu.get()).collect();
+    AlbedoIntegrator::default().grid(distribution, masking, &centres, &mus, progress)
 }
 
-/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`; `progress` is called once per
+/// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`; `progress` steps once per
 /// column.
 pub fn albedo_table(
     size: usize,
     distribution: Distribution,
     masking: Masking,
-    progress: Progress,
+    progress: &dyn Progress,
 ) -> Table {
-    let columns = albedo_columns(size, distribution, masking, progress);
+    let grid = albedo_grid(size, distribution, masking, progress);
     let mut data = Vec::with_capacity(size * size * 2);
     for y in 0..size {
-        for (_, e, e_avg) in &columns {
-            data.extend_from_slice(&[e[y] as f32, *e_avg as f32]);
+        for x in 0..size {
+            data.extend_from_slice(&[grid.e(y, x) as f32, grid.e_avg[x] as f32]);
         }
     }
     Table {
@@ -303,47 +236,48 @@ pub fn albedo_table(
 }
 
 /// Computes the Kulla–Conty tables for `distribution` with `masking`, `size × size`
-/// texels, `samples` Hammersley points per texel (columns in parallel); `progress` is
-/// called twice per column (albedo, then scale/bias).
+/// texels, `samples` Hammersley points per texel (columns in parallel); `progress` steps
+/// twice per column (albedo, then scale/bias).
 pub fn kulla_conty(
     size: usize,
     samples: u32,
     distribution: Distribution,
     masking: Masking,
-    progress: Progress,
+    progress: &dyn Progress,
 ) -> KullaConty {
-    let n = size as f64;
-    let columns: Vec<_> = albedo_columns(size, distribution, masking, progress)
+    let grid = albedo_grid(size, distribution, masking, progress);
+    let texels: Vec<Vec<(f64, f64, f64)>> = (0..size)
         .into_par_iter()
-        .map(|(glossy, e, e_avg)| {
+        .map(|x| {
+            let glossy = Glossy::new(distribution, masking, grid.roughness[x]);
+            let e = grid.column(x);
             let e_bar = column_average(&e);
-            let texels: Vec<_> = (0..size)
-                .map(|y| {
-                    let mu = (y as f64 + 0.5) / n;
+            let column = grid
+                .mu
+                .iter()
+                .map(|&mu| {
                     let (s, b) = scale_bias(&glossy, mu, samples);
-                    (s, b, fms_integral(mu, &e, e_bar, e_avg))
+                    (s, b, fms_integral(mu, &e, e_bar, grid.e_avg[x]))
                 })
                 .collect();
-            progress();
-            (e, e_avg, texels)
+            progress.step();
+            column
         })
         .collect();
     let mut kc = KullaConty {
         size,
         distribution,
         masking,
-        e: vec![0.0; size * size],
-        e_avg: vec![0.0; size],
+        e: grid.e,
+        e_avg: grid.e_avg,
         scale: vec![0.0; size * size],
         bias: vec![0.0; size * size],
         fms: vec![0.0; size * size],
     };
-    for (x, (e, e_avg, texels)) in columns.into_iter().enumerate() {
-        kc.e_avg[x] = e_avg;
-        for y in 0..size {
+    for (x, column) in texels.into_iter().enumerate() {
+        for (y, texel) in column.into_iter().enumerate() {
             let i = y * size + x;
-            kc.e[i] = e[y];
-            (kc.scale[i], kc.bias[i], kc.fms[i]) = texels[y];
+            (kc.scale[i], kc.bias[i], kc.fms[i]) = texel;
         }
     }
     kc

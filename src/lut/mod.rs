@@ -1,4 +1,4 @@
-//! Lookup tables for real-time renderers (DESIGN.md §5): the split-sum LUT and the
+//! Lookup tables for real-time renderers (`docs/PHYSICS.md` §10): the split-sum LUT and the
 //! Kulla–Conty energy-compensation LUT, written as EXR, DDS or KTX2 textures.
 //!
 //! # Layout (every kind, every format)
@@ -14,11 +14,11 @@
 //!   generator" (see [`split_sum`]); at run time `specular = F0 · scale + bias`. By default
 //!   sampled with GGX's visible normals at 2048 samples: 512² in about 0.37 s (ue4) /
 //!   0.45 s (height-correlated) on 2 cores, within 7.2e-4 of the converged table
-//!   (`cargo bench --bench lut`); `--sampling classic` is DESIGN.md §5 verbatim (1e-2 off
-//!   near grazing at 1024 samples).
+//!   (`cargo bench --bench lut`); `--sampling classic` is the textbook estimator verbatim
+//!   (1e-2 off near grazing at 1024 samples).
 //! * [`Kind::Albedo`], 2 channels, for the same Glossy BSDF: **R = E(μ, r)** and
 //!   **G = E_avg(r)** (constant along each column), both by the deterministic quadrature of
-//!   [`crate::microfacet::AlbedoIntegrator`] (no samples; max error 3.2e-5): the two
+//!   [`crate::measure::AlbedoIntegrator`] (no samples; max error 3.2e-5): the two
 //!   Kulla–Conty tables a renderer needs to build its own compensation.
 //! * [`Kind::KullaConty`], 4 channels, for the Glossy BSDF that Cycles evaluates (chosen by
 //!   `--distribution` and `--blender-version`; see [`kulla_conty`]):
@@ -27,7 +27,7 @@
 //!   `f_ms = (1 − E(μ))(1 − E(μi)) / (π (1 − E_avg))`, integrated in closed form; it is
 //!   `≈ 1 − E(μ)`), and **A = E_avg(r)** (constant along each column) for the Fresnel term
 //!   `F_avg E_avg / (1 − F_avg (1 − E_avg))` that scales B under a coloured Fresnel.
-//!   `E(μ, r)` itself (Cycles-exact, from [`crate::microfacet::AlbedoIntegrator`]) is in
+//!   `E(μ, r)` itself (Cycles-exact, from [`crate::measure::AlbedoIntegrator`]) is in
 //!   [`kulla_conty::KullaConty::e`].
 //!
 //! # Formats
@@ -49,15 +49,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::Error;
-use crate::blender::BlenderVersion;
-use crate::microfacet::Distribution;
-
-/// Called from worker threads once per finished unit of work (a row or a column; see
-/// [`Spec::progress_steps`]).
-pub type Progress<'a> = &'a (dyn Fn() + Sync);
-
-/// A [`Progress`] that reports nothing.
-pub fn no_progress() {}
+use crate::measure::{BlenderVersion, Distribution};
+use crate::output::{check_destination, write_atomic};
+use crate::progress::Progress;
 
 /// The largest `--size` accepted: 8192² texels of RGBA32F is already 1 GiB.
 pub const MAX_SIZE: u32 = 8192;
@@ -65,7 +59,7 @@ pub const MAX_SIZE: u32 = 8192;
 pub const MAX_SAMPLES: u32 = 1 << 20;
 
 /// Which table to compute.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Kind {
     /// GGX split-sum (R = scale, G = bias).
@@ -87,7 +81,7 @@ impl Kind {
 }
 
 /// The masking–shadowing term of the split-sum table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum GModel {
     /// Separable Schlick-GGX with k = α/2 (Karis' UE4 table).
@@ -107,12 +101,12 @@ impl GModel {
 
 /// How the split-sum integral is sampled (both estimate the same integral; see
 /// [`split_sum`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Sampling {
     /// GGX visible normals (Heitz 2018): bounded weights, 1e-3 at 2048 samples.
     VisibleNormals,
-    /// DESIGN.md §5 / UE4 to the letter: H ~ D·N·H; up to 1e-2 off near grazing at 1024.
+    /// The textbook (UE4) estimator to the letter: H ~ D·N·H; up to 1e-2 off near grazing at 1024.
     Classic,
 }
 
@@ -126,7 +120,7 @@ impl Sampling {
 }
 
 /// The container written.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Format {
     /// OpenEXR, ZIP-compressed scan lines.
@@ -134,7 +128,6 @@ pub enum Format {
     /// DirectDraw Surface with a DX10 header.
     Dds,
     /// KTX 2.0 (not KTX 1).
-    #[value(alias = "ktx2")]
     #[serde(rename = "ktx2")]
     Ktx,
 }
@@ -161,14 +154,12 @@ impl Format {
 }
 
 /// Bits per channel of the stored floats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum Bits {
     /// IEEE half floats (what GPUs sample fastest; rounding error ≤ 2.5e-4 below 1).
-    #[value(name = "16")]
     #[serde(rename = "16")]
     Half,
     /// IEEE single floats (exactly the computed values).
-    #[value(name = "32")]
     #[serde(rename = "32")]
     Float,
 }
@@ -180,62 +171,44 @@ impl Bits {
             Bits::Float => 32,
         }
     }
+
+    /// The command-line spelling: `16` or `32`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Bits::Half => "16",
+            Bits::Float => "32",
+        }
+    }
 }
 
-/// `gloffuse lut`: write a split-sum or Kulla–Conty lookup table as EXR, DDS or KTX2.
-///
-/// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
-#[derive(clap::Args, Debug, Clone, PartialEq)]
-pub struct LutArgs {
-    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G).
-    #[arg(long, value_enum, default_value_t = Kind::SplitSum)]
+/// What `gloffuse lut` computes and writes. `None` means the kind's default (see
+/// [`Spec::from_options`], which also refuses combinations that make no sense).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LutOptions {
     pub kind: Kind,
-
-    /// kulla-conty and albedo: beckmann, ggx or ashikhmin-shirley [default: ggx].
-    #[arg(long, short = 'd', value_parser = crate::cli::parse_distribution)]
+    /// kulla-conty and albedo: the distribution [default: GGX].
     pub distribution: Option<Distribution>,
-
-    /// kulla-conty and albedo: the Blender whose masking the BSDF follows (3.x separable, 3.6+ height-correlated) [default: 4.5].
-    #[arg(long, value_parser = crate::cli::parse_version)]
+    /// kulla-conty and albedo: the Blender whose masking the BSDF follows [default: 4.5].
     pub blender_version: Option<BlenderVersion>,
-
-    /// Texels per side, 1 to 8192 [default: 512 for split-sum, 64 for kulla-conty and albedo].
-    #[arg(long, value_name = "N")]
+    /// Texels per side [default: 512 split-sum, 64 otherwise].
     pub size: Option<u32>,
-
-    /// Hammersley samples per texel, 1 to 1048576 [default: 2048 split-sum (max error 7e-4), 4096 kulla-conty; albedo takes none: it is quadrature].
-    #[arg(long, value_name = "N")]
+    /// Hammersley samples per texel [default: 2048 split-sum, 4096 kulla-conty].
     pub samples: Option<u32>,
-
-    /// split-sum only: visible-normals (accurate) or classic (DESIGN.md §5 / UE4 verbatim) [default: visible-normals].
-    #[arg(long, value_enum)]
+    /// split-sum only [default: visible normals].
     pub sampling: Option<Sampling>,
-
-    /// Bits per channel: 16 (half float) or 32 (float).
-    #[arg(long, value_enum, default_value_t = Bits::Half)]
     pub bits: Bits,
-
-    /// split-sum only: ue4 (Schlick-GGX, k = α/2) or height-correlated (Smith GGX) [default: ue4].
-    #[arg(long, value_enum)]
+    /// split-sum only [default: ue4].
     pub g_model: Option<GModel>,
-
-    /// exr, dds or ktx (KTX 2.0) [default: from the --out extension: .exr, .dds, .ktx2/.ktx].
-    #[arg(long, value_enum)]
+    /// [default: from the extension of `out`].
     pub format: Option<Format>,
-
     /// The file to write (atomically: it appears complete or not at all).
-    #[arg(long, short = 'o', value_name = "FILE")]
     pub out: PathBuf,
-
-    /// Print the summary as JSON.
-    #[arg(long)]
-    pub json: bool,
 }
 
-impl LutArgs {
-    /// Arguments with every default, writing to `out`.
+impl LutOptions {
+    /// Options with every default, writing to `out`.
     pub fn new(kind: Kind, out: impl Into<PathBuf>) -> Self {
-        LutArgs {
+        LutOptions {
             kind,
             distribution: None,
             blender_version: None,
@@ -246,7 +219,6 @@ impl LutArgs {
             g_model: None,
             format: None,
             out: out.into(),
-            json: false,
         }
     }
 }
@@ -282,7 +254,7 @@ impl Table {
     }
 }
 
-/// What a validated request computes (parse, don't validate: built once from [`LutArgs`]).
+/// What a validated request computes (parse, don't validate: built once from [`LutOptions`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Spec {
     SplitSum {
@@ -306,7 +278,7 @@ pub enum Spec {
 
 impl Spec {
     /// Checks the numbers and the flag combinations; errors name the flag.
-    pub fn from_args(args: &LutArgs) -> Result<Spec, Error> {
+    pub fn from_options(args: &LutOptions) -> Result<Spec, Error> {
         let (default_size, default_samples) = match args.kind {
             Kind::SplitSum => (512, 2048),
             Kind::KullaConty => (64, 4096),
@@ -371,9 +343,7 @@ impl Spec {
                     ));
                 }
                 let distribution = args.distribution.unwrap_or(Distribution::Ggx);
-                let blender_version = args
-                    .blender_version
-                    .unwrap_or(BlenderVersion { major: 4, minor: 5 });
+                let blender_version = args.blender_version.unwrap_or(BlenderVersion::DEFAULT);
                 if args.kind == Kind::KullaConty {
                     return Ok(Spec::KullaConty {
                         size,
@@ -398,7 +368,7 @@ impl Spec {
         }
     }
 
-    /// How many times [`Spec::compute`] calls its `progress`.
+    /// How many times [`Spec::compute`] steps its `progress`.
     pub fn progress_steps(&self) -> usize {
         match *self {
             Spec::SplitSum { size, .. } | Spec::Albedo { size, .. } => size,
@@ -407,7 +377,7 @@ impl Spec {
     }
 
     /// Computes the table.
-    pub fn compute(&self, progress: Progress) -> Table {
+    pub fn compute(&self, progress: &dyn Progress) -> Table {
         match *self {
             Spec::SplitSum {
                 size,
@@ -485,10 +455,10 @@ pub struct LutSummary {
 }
 
 /// Computes the table `args` asks for, encodes it in memory and writes it atomically to
-/// `args.out` (nothing is created on any error).
-pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
+/// `args.out` (nothing is created on any error); `progress` steps per row or column.
+pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Error> {
     let start = Instant::now();
-    let spec = Spec::from_args(args)?;
+    let spec = Spec::from_options(args)?;
     let format = match args.format {
         Some(f) => f,
         None => Format::from_path(&args.out).ok_or_else(|| {
@@ -500,26 +470,20 @@ pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
         })?,
     };
     // A bad destination fails before minutes of computing, not after.
-    crate::output::check_destination(&args.out)?;
+    check_destination(&args.out)?;
     let t = Instant::now();
-    // On stderr, and only when it is a terminal (indicatif hides it otherwise).
-    let bar = indicatif::ProgressBar::new(spec.progress_steps() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:30}] {percent}%, {elapsed} (ETA {eta})",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
+    progress.begin(
+        &format!("computing the {} table", args.kind.key()),
+        spec.progress_steps() as u64,
     );
-    bar.set_message(format!("computing the {} table", args.kind.key()));
-    let table = spec.compute(&|| bar.inc(1));
-    bar.finish_and_clear();
+    let table = spec.compute(progress);
+    progress.end();
     let compute_seconds = t.elapsed().as_secs_f64();
     let bytes = encode(&table, format, args.bits).map_err(|message| Error::Write {
         path: args.out.clone(),
         message: format!("cannot encode the table as {}: {message}", format.key()),
     })?;
-    crate::output::write_atomic(&args.out, &bytes)?;
+    write_atomic(&args.out, &bytes)?;
     let (samples, g_model, sampling, distribution, blender_version, channels) = match spec {
         Spec::SplitSum {
             samples,
@@ -583,50 +547,6 @@ pub fn lut(args: &LutArgs) -> Result<LutSummary, Error> {
         compute_seconds,
         seconds: start.elapsed().as_secs_f64(),
     })
-}
-
-/// The human-readable summary `gloffuse lut` prints.
-pub fn describe(s: &LutSummary) -> String {
-    let mut out = format!(
-        "wrote {} ({} bytes): {} {}×{} {}, {} {}-bit\n",
-        s.path.display(),
-        s.bytes,
-        s.kind.key(),
-        s.width,
-        s.height,
-        s.format.key(),
-        s.pixel_format,
-        s.bits.count(),
-    );
-    let mut how = vec![match s.samples {
-        Some(n) => format!("{n} samples per texel"),
-        None => "deterministic quadrature".to_string(),
-    }];
-    if let Some(g) = s.g_model {
-        how.push(format!("{} masking", g.key()));
-    }
-    if let Some(m) = s.sampling {
-        how.push(format!("{} sampling", m.key()));
-    }
-    if let Some(d) = s.distribution {
-        how.push(format!("{d}"));
-    }
-    if let Some(v) = &s.blender_version {
-        how.push(format!("Blender {v}"));
-    }
-    out += &format!("  {}\n", how.join(", "));
-    for c in &s.channels {
-        out += &format!("  {c}\n");
-    }
-    out += &format!(
-        "  uv = (roughness, N·V); texel (x, y) at ((x + ½)/{}, (y + ½)/{}), first row first\n",
-        s.width, s.height
-    );
-    out += &format!(
-        "  computed in {:.2} s ({:.2} s in all)\n",
-        s.compute_seconds, s.seconds
-    );
-    out
 }
 
 fn pixel_format_name(format: Format, bits: Bits, channels: usize) -> String {

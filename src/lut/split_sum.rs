@@ -1,5 +1,5 @@
 //! The split-sum LUT (Karis 2013, "Real Shading in Unreal Engine 4"; the classic "BRDF
-//! generator") of DESIGN.md §5, vectorised.
+//! generator"; `docs/PHYSICS.md` §10), vectorised.
 //!
 //! # The integral
 //!
@@ -14,7 +14,7 @@
 //!
 //! # Two estimators of it ([`Sampling`])
 //!
-//! * [`Sampling::Classic`] is DESIGN.md §5 to the letter: Hammersley points
+//! * [`Sampling::Classic`] is the textbook estimator to the letter: Hammersley points
 //!   `(u, v) = (i/N, radical_inverse₂(i))`, `φ = 2πu`,
 //!   `cos θh = √((1 − v)/(1 + (α² − 1) v))`, and the sums above divided by N (samples with
 //!   `N·L ≤ 0` still count). Its weight `G_Vis` grows like `tan θh / α` towards grazing
@@ -35,10 +35,13 @@
 //! bit-identical whether the kernel runs as SSE2 or AVX2 code (chosen at run time; no FMA)
 //! and for any thread count. Rows run in parallel (rayon).
 
+use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-use super::{GModel, Progress, Sampling};
+use super::{GModel, Sampling};
+use crate::measure::{Distribution, Masking, Microfacet};
+use crate::progress::Progress;
 
 /// Lanes of the inner kernels (one AVX register of f32).
 const LANES: usize = 8;
@@ -55,20 +58,12 @@ pub fn hammersley(i: u32, n: u32) -> (f64, f64) {
     (f64::from(i) / f64::from(n), radical_inverse_base2(i))
 }
 
-/// GGX importance sample of the half vector's polar angle for CDF value `v`:
-/// `(cos θh, sin θh)` with `cos²θh = (1 − v)/(1 + (α² − 1) v)` (the classic formula, written
-/// through `tan²θh = α² v/(1 − v)` so that tiny α keeps its precision).
-pub fn ggx_polar(alpha: f64, v: f64) -> (f64, f64) {
-    let a2 = alpha * alpha;
-    let den = (1.0 - v) + a2 * v;
-    (((1.0 - v) / den).sqrt(), (a2 * v / den).sqrt())
-}
-
-/// Smith's Λ for GGX at cosine `c`: `(√(1 + α² tan²θ) − 1)/2`.
-pub fn ggx_lambda(alpha: f64, c: f64) -> f64 {
-    let a2 = alpha * alpha;
-    let tan2 = ((1.0 - c * c) / (c * c)).max(0.0);
-    ((1.0 + a2 * tan2).sqrt() - 1.0) * 0.5
+/// The GGX lobe of width `alpha`.
+fn ggx(alpha: f64) -> Microfacet {
+    Microfacet {
+        distribution: Distribution::Ggx,
+        alpha,
+    }
 }
 
 /// The masking–shadowing term `G(V, L)` of a split-sum model, in f64.
@@ -79,7 +74,7 @@ pub fn g(g_model: GModel, alpha: f64, nov: f64, nol: f64) -> f64 {
             let g1 = |x: f64| x / (x * (1.0 - k) + k);
             g1(nov) * g1(nol)
         }
-        GModel::HeightCorrelated => 1.0 / (1.0 + ggx_lambda(alpha, nov) + ggx_lambda(alpha, nol)),
+        GModel::HeightCorrelated => ggx(alpha).g2(Masking::HeightCorrelated, nov, nol),
     }
 }
 
@@ -121,7 +116,7 @@ impl Disk {
 }
 
 /// Disk point `i` of `n`: `ρ² = (i + ½)/n` (centred), `φ = 2π radical_inverse₂(i)`.
-fn disk_point(i: u32, n: u32) -> (f64, f64) {
+pub fn disk_point(i: u32, n: u32) -> (f64, f64) {
     let rho = ((f64::from(i) + 0.5) / f64::from(n)).sqrt();
     let phi = 2.0 * PI * radical_inverse_base2(i);
     (rho * phi.cos(), rho * phi.sin())
@@ -156,7 +151,7 @@ impl VisiblePixel {
         let (ax, az) = (alpha * vx, nov);
         let len = (ax * ax + az * az).sqrt();
         let (a, b) = (ax / len, az / len);
-        let lambda_v = ggx_lambda(alpha, nov);
+        let lambda_v = ggx(alpha).lambda(nov);
         let (k, c, lv) = match g_model {
             GModel::Ue4 => {
                 let k = alpha / 2.0;
@@ -263,9 +258,9 @@ impl Column {
         let mut hz = vec![0.0f32; padded];
         for i in 0..samples {
             let (u, v) = hammersley(i, samples);
-            let (cos_t, sin_t) = ggx_polar(alpha, v);
-            hx[i as usize] = (sin_t * (2.0 * PI * u).cos()) as f32;
-            hz[i as usize] = cos_t as f32;
+            let h = ggx(alpha).sample_polar(v);
+            hx[i as usize] = (h.sin * (2.0 * PI * u).cos()) as f32;
+            hz[i as usize] = h.cos as f32;
         }
         Column { hx, hz }
     }
@@ -303,7 +298,7 @@ impl ClassicPixel {
                 nov: nov as f32,
                 k: (alpha * alpha) as f32,
                 c: (2.0 / nov) as f32,
-                lv: (1.0 + 2.0 * ggx_lambda(alpha, nov)) as f32,
+                lv: (1.0 + 2.0 * ggx(alpha).lambda(nov)) as f32,
             },
         }
     }
@@ -412,13 +407,13 @@ fn row<const HC: bool>(points: &Points, g_model: GModel, y: usize, size: usize) 
 }
 
 /// The split-sum table, row-major (row y = `N·V` index), two interleaved channels per texel:
-/// `[scale, bias]`. `size ≥ 1`, `samples ≥ 1`; `progress` is called once per row.
+/// `[scale, bias]`. `size ≥ 1`, `samples ≥ 1`; `progress` steps once per row.
 pub fn split_sum(
     size: usize,
     samples: u32,
     g_model: GModel,
     sampling: Sampling,
-    progress: Progress,
+    progress: &dyn Progress,
 ) -> Vec<f32> {
     let n = size as f64;
     let points = match sampling {
@@ -440,7 +435,7 @@ pub fn split_sum(
                 GModel::Ue4 => row::<false>(&points, g_model, y, size),
                 GModel::HeightCorrelated => row::<true>(&points, g_model, y, size),
             };
-            progress();
+            progress.step();
             row
         })
         .collect();
@@ -449,41 +444,6 @@ pub fn split_sum(
         .flatten()
         .flat_map(|(s, b)| [(s * inv) as f32, (b * inv) as f32])
         .collect()
-}
-
-/// Heitz's (2018) sample of GGX's visible normals for view `v` (unit, `v.z > 0`) with the
-/// centred Hammersley disk point `i` of `samples`, in plain f64 with full 3-vectors: the
-/// half vector H, with density `G1(V) max(0, V·H) D(H) / N·V` (Smith's `G1 = 1/(1 + Λ)`).
-pub fn ggx_visible_normal(alpha: f64, v: [f64; 3], i: u32, samples: u32) -> [f64; 3] {
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let vh = {
-        let h = [alpha * v[0], alpha * v[1], v[2]];
-        let l = dot(h, h).sqrt();
-        [h[0] / l, h[1] / l, h[2] / l]
-    };
-    let lensq = vh[0] * vh[0] + vh[1] * vh[1];
-    let t1_axis = if lensq > 0.0 {
-        [-vh[1] / lensq.sqrt(), vh[0] / lensq.sqrt(), 0.0]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let t2_axis = [
-        vh[1] * t1_axis[2] - vh[2] * t1_axis[1],
-        vh[2] * t1_axis[0] - vh[0] * t1_axis[2],
-        vh[0] * t1_axis[1] - vh[1] * t1_axis[0],
-    ];
-    let (t1, t2) = disk_point(i, samples);
-    let s = 0.5 * (1.0 + vh[2]);
-    let t2 = (1.0 - s) * (1.0 - t1 * t1).sqrt() + s * t2;
-    let w = (1.0 - t1 * t1 - t2 * t2).max(0.0).sqrt();
-    let nh = [
-        t1 * t1_axis[0] + t2 * t2_axis[0] + w * vh[0],
-        t1 * t1_axis[1] + t2 * t2_axis[1] + w * vh[1],
-        t1 * t1_axis[2] + t2 * t2_axis[2] + w * vh[2],
-    ];
-    let ne = [alpha * nh[0], alpha * nh[1], nh[2].max(0.0)];
-    let l = dot(ne, ne).sqrt();
-    [ne[0] / l, ne[1] / l, ne[2] / l]
 }
 
 /// One texel computed in plain f64, sample by sample, from the textbook formulas (with the
@@ -497,22 +457,23 @@ pub fn split_sum_texel_f64(
     sampling: Sampling,
 ) -> (f64, f64) {
     let alpha = r * r;
-    let v = [(1.0 - nov * nov).sqrt(), 0.0, nov];
-    let g1_smith_v = 1.0 / (1.0 + ggx_lambda(alpha, nov));
+    let lobe = ggx(alpha);
+    let v = DVec3::new((1.0 - nov * nov).sqrt(), 0.0, nov);
+    let g1_smith_v = lobe.g1(nov);
     let (mut scale, mut bias) = (0.0, 0.0);
     for i in 0..samples {
         let h = match sampling {
             Sampling::Classic => {
                 let (u1, u2) = hammersley(i, samples);
-                let (cos_t, sin_t) = ggx_polar(alpha, u2);
+                let polar = lobe.sample_polar(u2);
                 let phi = 2.0 * PI * u1;
-                [sin_t * phi.cos(), sin_t * phi.sin(), cos_t]
+                DVec3::new(polar.sin * phi.cos(), polar.sin * phi.sin(), polar.cos)
             }
-            Sampling::VisibleNormals => ggx_visible_normal(alpha, v, i, samples),
+            Sampling::VisibleNormals => lobe.sample_visible_normal(v, disk_point(i, samples)),
         };
-        let voh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
-        let nol = 2.0 * voh * h[2] - v[2];
-        let noh = h[2];
+        let voh = v.dot(h);
+        let nol = 2.0 * voh * h.z - v.z;
+        let noh = h.z;
         if nol > 0.0 {
             let g = g(g_model, alpha, nov, nol);
             let w = match sampling {

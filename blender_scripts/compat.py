@@ -1,0 +1,282 @@
+# ---------------------------------------------------------------------------
+# gloffuse compat.py: the compatibility shim. Every difference between the
+# Blender versions gloffuse supports (3.4 .. 5.0; the binary, its Text Editor,
+# or the `bpy` module) lives here and nowhere else.
+#
+# One part of the script the gloffuse binary concatenates: header
+# (GLOFFUSE_PARAMS), compat.py, params.py, nodes.py, roughness_groups.py,
+# view_groups.py, groups.py, runtime.py, then a main (generate_main.py or
+# furnace_main.py). It defines functions and constants only.
+# ---------------------------------------------------------------------------
+import bpy
+import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
+
+
+# --- version -----------------------------------------------------------------
+
+def blender_version_string():
+    """Blender's version as "major.minor.patch" (no "LTS" suffix)."""
+    return ".".join(str(part) for part in bpy.app.version)
+
+
+def max_name_bytes():
+    """Blender's name length limit in bytes (63 where it cannot be read)."""
+    try:
+        return bpy.types.ID.bl_rna.properties["name"].length_max - 1
+    except (AttributeError, KeyError):
+        return 63
+
+
+# --- group interface (sockets) -------------------------------------------------
+
+def has_interface_api(tree):
+    """Blender 4.0+ describes group sockets with tree.interface."""
+    return hasattr(tree, "interface")
+
+
+# Blender 3.x encodes a float socket's subtype in the socket type name.
+_LEGACY_SUBTYPE_SUFFIX = {"FACTOR": "Factor"}
+
+
+def new_socket(tree, name, in_out, socket_type, subtype=None):
+    """Append a group socket. in_out is 'INPUT' or 'OUTPUT'; socket_type is a
+    base type name such as 'NodeSocketFloat'. Returns the interface socket,
+    on which default_value, min_value, max_value and hide_value live."""
+    if has_interface_api(tree):
+        sock = tree.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+        set_socket_subtype(sock, subtype)
+        return sock
+    idname = socket_type + _LEGACY_SUBTYPE_SUFFIX.get(subtype, "")
+    sockets = tree.inputs if in_out == "INPUT" else tree.outputs
+    return sockets.new(idname, name)
+
+
+def interface_sockets(tree, in_out):
+    """The group's sockets of one direction, in order."""
+    if has_interface_api(tree):
+        return [item for item in tree.interface.items_tree
+                if item.item_type == "SOCKET" and item.in_out == in_out]
+    return list(tree.inputs if in_out == "INPUT" else tree.outputs)
+
+
+def interface_has_panels(tree):
+    if not has_interface_api(tree):
+        return False
+    return any(item.item_type != "SOCKET" for item in tree.interface.items_tree)
+
+
+def socket_type_of(sock):
+    """Base socket type name ('NodeSocketFloat', ...) of an interface socket."""
+    if hasattr(sock, "socket_type"):
+        return sock.socket_type
+    idname = sock.bl_socket_idname  # 3.x: 'NodeSocketFloatFactor' and the like
+    return "NodeSocketFloat" if idname.startswith("NodeSocketFloat") else idname
+
+
+def signature_subtype(tree, subtype):
+    """The part of a wanted socket's subtype that belongs in its signature (what
+    must match for an existing socket to be kept): in 3.x the subtype is part
+    of the socket type, so it is part of the signature there; 4.0+: None."""
+    return subtype if not has_interface_api(tree) else None
+
+
+def existing_signature_subtype(tree, sock):
+    """The subtype a 3.x socket's type name encodes ('FACTOR' for
+    NodeSocketFloatFactor), or None; always None in 4.0+."""
+    subtype = None
+    if not has_interface_api(tree):
+        for key, suffix in _LEGACY_SUBTYPE_SUFFIX.items():
+            if sock.bl_socket_idname == "NodeSocketFloat" + suffix:
+                subtype = key
+    return subtype
+
+
+def set_socket_subtype(sock, subtype):
+    """4.0+: an interface socket's subtype is a property (3.x: part of its type)."""
+    if subtype and hasattr(sock, "subtype"):
+        sock.subtype = subtype
+
+
+def set_socket_description(sock, text):
+    """The socket's tooltip, where the version has one."""
+    if hasattr(sock, "description"):
+        sock.description = text
+
+
+def set_socket_hide_value(sock, hide):
+    if hasattr(sock, "hide_value"):
+        sock.hide_value = hide
+
+
+def clear_interface(tree):
+    """Remove every group socket (and panel)."""
+    if has_interface_api(tree):
+        tree.interface.clear()
+    else:
+        tree.inputs.clear()
+        tree.outputs.clear()
+
+
+# --- tree description and asset ---------------------------------------------
+
+def set_tree_description(tree, text):
+    """NodeTree.description exists from Blender 4.0 (shown as a tooltip)."""
+    if hasattr(tree, "description"):
+        tree.description = text
+
+
+def mark_asset(tree, description, tags):
+    """Mark the group as an asset (Blender 3.0+) so it shows in the Asset
+    Browser, with a description and tags. Does nothing where unsupported."""
+    if not hasattr(tree, "asset_mark"):
+        return False
+    if getattr(tree, "asset_data", None) is None:
+        tree.asset_mark()
+    data = getattr(tree, "asset_data", None)
+    if data is None:
+        return False
+    if hasattr(data, "description"):
+        data.description = description
+    if hasattr(data, "author") and not data.author:
+        data.author = "gloffuse"
+    if hasattr(data, "tags"):
+        present = {tag.name for tag in data.tags}
+        for tag in tags:
+            if tag not in present:
+                data.tags.new(tag, skip_if_exists=True)
+    return True
+
+
+# --- nodes -----------------------------------------------------------------------
+
+def glossy_node(nodes, distribution):
+    """A Glossy BSDF with an explicit distribution. In 4.0+ the Glossy node is
+    the former Anisotropic node (idname ShaderNodeBsdfAnisotropic) and a new
+    one defaults to MULTI_GGX, so the distribution is always set."""
+    node = nodes.new("ShaderNodeBsdfGlossy")
+    allowed = [item.identifier for item in
+               node.bl_rna.properties["distribution"].enum_items]
+    if distribution not in allowed:
+        raise ValueError("Blender %s's Glossy BSDF has no distribution %r (it has %s)"
+                         % (blender_version_string(), distribution, ", ".join(allowed)))
+    node.distribution = distribution
+    return node
+
+
+def find_socket(sockets, identifier):
+    for sock in sockets:
+        if sock.identifier == identifier:
+            return sock
+    raise KeyError("no socket with identifier %r" % identifier)
+
+
+def multiply_color_node(nodes):
+    """A colour multiply with factor 1: returns (node, a_in, b_in, out).
+    ShaderNodeMix (3.4+) in RGBA/MULTIPLY mode, sockets found by identifier
+    because several share the names A, B and Result; the legacy MixRGB node
+    where ShaderNodeMix does not exist."""
+    if hasattr(bpy.types, "ShaderNodeMix"):
+        node = nodes.new("ShaderNodeMix")
+        node.data_type = "RGBA"
+        node.blend_type = "MULTIPLY"
+        node.clamp_factor = True
+        node.clamp_result = False
+        fac = find_socket(node.inputs, "Factor_Float")
+        a = find_socket(node.inputs, "A_Color")
+        b = find_socket(node.inputs, "B_Color")
+        out = find_socket(node.outputs, "Result_Color")
+    else:
+        node = nodes.new("ShaderNodeMixRGB")
+        node.blend_type = "MULTIPLY"
+        node.use_clamp = False
+        fac, a, b = node.inputs[0], node.inputs[1], node.inputs[2]
+        out = node.outputs[0]
+    fac.default_value = 1.0
+    return node, a, b, out
+
+
+def set_parent(node, frame):
+    """Put node in frame. The frame sits at the origin, so a child's location
+    means the same whether Blender stores it relative to the frame (before 4.4)
+    or absolute (4.4+)."""
+    node.parent = frame
+
+
+# --- furnace scene (used by furnace_main.py) -----------------------------------
+
+def compat_node_tree(id_block):
+    """The node tree of a world or material, creating it where needed.
+    3.x/4.x: node_tree is None until use_nodes is set; 5.0: always present and
+    use_nodes is deprecated, so it is only touched when there is no tree."""
+    if id_block.node_tree is None and hasattr(id_block, "use_nodes"):
+        id_block.use_nodes = True
+    if id_block.node_tree is None:
+        raise RuntimeError("%s %r has no node tree" % (type(id_block).__name__, id_block.name))
+    return id_block.node_tree
+
+
+def compat_camera_rays_only(obj):
+    """Make an object visible to camera rays only (3.0+: Object.visible_*;
+    2.9x: Object.cycles_visibility.*)."""
+    flags = {"camera": True, "diffuse": False, "glossy": False, "transmission": False,
+             "volume_scatter": False, "shadow": False}
+    if hasattr(obj, "visible_diffuse"):
+        for name, value in flags.items():
+            setattr(obj, "visible_" + name, value)
+    else:
+        visibility = obj.cycles_visibility
+        for name, value in flags.items():
+            key = "scatter" if name == "volume_scatter" else name
+            if hasattr(visibility, key):
+                setattr(visibility, key, value)
+
+
+def compat_disable_denoising(scene):
+    scene.cycles.use_denoising = False
+    for view_layer in scene.view_layers:
+        if hasattr(view_layer, "cycles") and hasattr(view_layer.cycles, "use_denoising"):
+            view_layer.cycles.use_denoising = False
+
+
+def compat_disable_time_limit(cycles):
+    """Cycles' render time limit (0 = none), where the version has one."""
+    if hasattr(cycles, "time_limit"):
+        cycles.time_limit = 0.0
+
+
+def compat_exr_settings(settings):
+    """Single-layer OpenEXR, RGBA, 32-bit float, ZIP (the exr crate reads ZIP,
+    not DWAA/DWAB). 5.0 needs media_type before file_format."""
+    if hasattr(settings, "media_type"):
+        settings.media_type = "IMAGE"
+    settings.file_format = "OPEN_EXR"
+    settings.color_mode = "RGBA"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    if hasattr(settings, "use_zbuffer"):
+        settings.use_zbuffer = False
+    if hasattr(settings, "use_preview"):
+        settings.use_preview = False
+    if hasattr(settings, "color_management"):
+        settings.color_management = "FOLLOW_SCENE"
+
+
+def compat_uv_sphere(bm, radius, segments, rings):
+    # bmesh's create_uvsphere takes `radius` since 3.0 (`diameter`, which was
+    # really a radius, before).
+    try:
+        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+    except TypeError:
+        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, diameter=radius)
+
+
+def compat_disable_auto_smooth(mesh):
+    """Before 4.1 a mesh's Auto Smooth could split smooth normals; 4.1+ has none."""
+    if hasattr(mesh, "use_auto_smooth"):
+        mesh.use_auto_smooth = False
+
+
+def compat_disable_post_processing(render):
+    for name in ("use_compositing", "use_sequencer"):
+        if hasattr(render, name):
+            setattr(render, name, False)

@@ -1,0 +1,231 @@
+# ---------------------------------------------------------------------------
+# gloffuse nodes.py: node-building helpers shared by the roughness-only and
+# the view-dependent groups: layout, the curve as text and as numbers,
+# reusing a group in place, its sockets, Math nodes, the clamped roughness,
+# frames and descriptions.
+#
+# One part of the script the gloffuse binary concatenates: header, compat.py,
+# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py,
+# runtime.py, then a main. Functions and constants only; every version
+# difference it meets goes through compat.py.
+# ---------------------------------------------------------------------------
+import bpy
+
+# Layout of the generated nodes (Blender node-editor units).
+NODE_WIDTH = 180.0
+COLUMN_STEP = 230.0   # NODE_WIDTH plus a 50-unit gap
+ROW_STEP = 240.0      # taller than a Math node showing three inputs
+FRAME_INSET = 250.0   # first column inside the frame, clear of the Group Input
+
+
+# ---------------------------------------------------------------------------
+# The curve as text and as numbers
+# ---------------------------------------------------------------------------
+
+def trim_coefficients(coefficients):
+    """Ascending coefficients without trailing zeros (at least one kept)."""
+    coeffs = [float(c) for c in coefficients]
+    while len(coeffs) > 1 and coeffs[-1] == 0.0:
+        coeffs.pop()
+    return coeffs
+
+
+def fmt(value):
+    """A short, exact-looking number for labels: 38.0, -79.0, 0.123457."""
+    text = repr(float(value))
+    if len(text) > 9:
+        text = "%.6g" % value
+    return text
+
+
+def polynomial_text(coefficients, var="x"):
+    """'38.0 x³ - 79.0 x² + 100.0' (highest power first, zero terms left out)."""
+    powers = {1: "", 2: "\u00b2", 3: "\u00b3"}
+    terms = []
+    for power in range(len(coefficients) - 1, -1, -1):
+        c = coefficients[power]
+        if c == 0.0 and len(coefficients) > 1:
+            continue
+        if power == 0:
+            body = fmt(abs(c))
+        else:
+            body = "%s %s%s" % (fmt(abs(c)), var, powers.get(power, "^%d" % power))
+        sign = "-" if c < 0 else "+"
+        terms.append((sign, body))
+    if not terms:
+        return "0"
+    first_sign, first_body = terms[0]
+    text = ("-" if first_sign == "-" else "") + first_body
+    for sign, body in terms[1:]:
+        text += " %s %s" % (sign, body)
+    return text
+
+
+def curve_text(curve):
+    """The curve f(x) in percent, as one line."""
+    num = polynomial_text(trim_coefficients(curve["numerator"]))
+    den = trim_coefficients(curve["denominator"])
+    var = "x = roughness" if curve["variable"] == "roughness" else "x = roughness\u00b2"
+    if len(den) == 1 and den[0] == 1.0:
+        return "f(x) = %s  (%s)" % (num, var)
+    return "f(x) = (%s) / (%s)  (%s)" % (num, polynomial_text(den), var)
+
+
+def short_label(text, limit=63):
+    """Blender keeps at most 63 bytes of a label: cut on a character boundary."""
+    data = text.encode("utf-8")
+    if len(data) <= limit:
+        return text
+    return data[:limit].decode("utf-8", "ignore")
+
+
+def frame_label(curve):
+    """'Gain = 100 / f(x), f(x) = 38.0 x³ - 79.0 x² + 100.0' when it fits in a
+    label, else 'Gain = 100 / f(x)'."""
+    num = trim_coefficients(curve["numerator"])
+    den = trim_coefficients(curve["denominator"])
+    if len(den) == 1:
+        body = polynomial_text([c / den[0] for c in num])
+    else:
+        body = "(%s) / (%s)" % (polynomial_text(num), polynomial_text(den))
+    text = "Gain = 100 / f(x),  f(x) = " + body
+    return text if len(text.encode("utf-8")) <= 63 else "Gain = 100 / f(x)"
+
+
+def gain_at(curve, roughness):
+    """The gain 100 * den(x) / num(x) in plain Python (for tests and checks)."""
+    x = min(max(float(roughness), 0.0), 1.0)
+    if curve["variable"] == "alpha":
+        x = x * x
+
+    def horner(coeffs):
+        acc = 0.0
+        for c in reversed([float(v) for v in coeffs]):
+            acc = acc * x + c
+        return acc
+    return 100.0 * horner(curve["denominator"]) / horner(curve["numerator"])
+
+
+# ---------------------------------------------------------------------------
+# Building the groups
+# ---------------------------------------------------------------------------
+
+def reuse_or_create_group(name):
+    """The local ShaderNodeTree called `name`, emptied of nodes, or a new one.
+    Reusing the datablock keeps every material that uses it working (no
+    ".001" copy, same pointer)."""
+    for tree in bpy.data.node_groups:
+        if tree.name == name and tree.library is None:
+            if tree.bl_idname != "ShaderNodeTree":
+                raise ValueError("a node group called %r already exists but is a %s, "
+                                 "not a shader node group; rename it and run again"
+                                 % (name, tree.bl_idname))
+            tree.nodes.clear()
+            return tree
+    tree = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    if tree.name != name:
+        raise ValueError("Blender renamed the new node group %r to %r" % (name, tree.name))
+    return tree
+
+
+def _socket_signature(in_out, name, socket_type, subtype):
+    """What must match for an existing socket to be kept: direction, name,
+    type, and the subtype where it is part of the type (compat.py's
+    signature_subtype: 3.x only)."""
+    sig = (in_out, name, socket_type)
+    if subtype is not None:
+        sig += (subtype,)
+    return sig
+
+
+def _existing_signature(tree, in_out, sock):
+    return _socket_signature(in_out, sock.name, socket_type_of(sock),
+                             existing_signature_subtype(tree, sock))
+
+
+def ensure_interface(tree, sockets):
+    """Give the tree exactly these sockets, in order.
+
+    sockets: list of dicts with in_out, name, type, and optional subtype,
+    default, min, max, hide_value, description. When the existing sockets
+    already have the same directions, names and types, they are updated in
+    place: their identifiers stay, so links from the group nodes in materials
+    survive a re-run. Otherwise the interface is rebuilt."""
+    wanted = []
+    have = []
+    for in_out in ("INPUT", "OUTPUT"):
+        for spec in sockets:
+            if spec["in_out"] == in_out:
+                subtype = signature_subtype(tree, spec.get("subtype"))
+                wanted.append(_socket_signature(in_out, spec["name"], spec["type"], subtype))
+        for sock in interface_sockets(tree, in_out):
+            have.append(_existing_signature(tree, in_out, sock))
+    if wanted != have or interface_has_panels(tree):
+        clear_interface(tree)
+        for spec in sockets:
+            new_socket(tree, spec["name"], spec["in_out"], spec["type"], spec.get("subtype"))
+    for spec in sockets:
+        sock = [s for s in interface_sockets(tree, spec["in_out"])
+                if s.name == spec["name"]][0]
+        set_socket_subtype(sock, spec.get("subtype"))
+        if "description" in spec:
+            set_socket_description(sock, spec["description"])
+        if "min" in spec:
+            sock.min_value = spec["min"]
+        if "max" in spec:
+            sock.max_value = spec["max"]
+        if "default" in spec:
+            sock.default_value = spec["default"]
+        set_socket_hide_value(sock, bool(spec.get("hide_value", False)))
+
+
+def math_node(tree, operation, label, location, parent=None, name=None):
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    node.use_clamp = False
+    node.label = short_label(label)
+    if name:
+        node.name = name
+    node.width = NODE_WIDTH
+    if parent is not None:
+        set_parent(node, parent)
+    node.location = location
+    return node
+
+
+def clamped_roughness(tree, group_in, frame, label="r = clamp(Roughness)"):
+    """A Clamp node clamp(Roughness, 0, 1) in the frame's first column, fed by
+    the Group Input's Roughness. Returns its output socket."""
+    clamp = tree.nodes.new("ShaderNodeClamp")
+    clamp.name = "Clamp roughness"
+    clamp.label = label
+    clamp.clamp_type = "MINMAX"
+    clamp.inputs["Min"].default_value = 0.0
+    clamp.inputs["Max"].default_value = 1.0
+    clamp.width = NODE_WIDTH
+    set_parent(clamp, frame)
+    clamp.location = (FRAME_INSET, 0.0)
+    tree.links.new(group_in.outputs["Roughness"], clamp.inputs["Value"])
+    return clamp.outputs[0]
+
+
+def new_frame(tree, name, label):
+    """The shrinking frame, at the origin (see compat.py's set_parent), that
+    holds a group's arithmetic."""
+    frame = tree.nodes.new("NodeFrame")
+    frame.name = name
+    frame.label = short_label(label)
+    frame.shrink = True
+    frame.location = (0.0, 0.0)
+    return frame
+
+
+def description_text(spec, params, what):
+    """Description for a tree and its asset: the spec's own text, then `what`
+    (what the group computes), then where its coefficients come from."""
+    source = "Coefficients: %s. Generated by gloffuse %s in Blender %s." % (
+        params.get("coefficients_source", "unknown"),
+        params.get("gloffuse_version", "?"),
+        blender_version_string())
+    parts = [spec.get("description", "").strip(), what, source]
+    return "\n\n".join(part for part in parts if part)

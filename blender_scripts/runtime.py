@@ -1,0 +1,120 @@
+# ---------------------------------------------------------------------------
+# gloffuse runtime.py: helpers for the main scripts (generate_main.py,
+# furnace_main.py): the script's own arguments, opening and saving .blend
+# files, the result line, and error handling that never quits an interactive
+# Blender.
+#
+# One part of the script the gloffuse binary concatenates: header, compat.py,
+# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py,
+# runtime.py, then a main. Functions and classes only.
+#
+#   script_args(argv=None) -> the arguments meant for the script
+#   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
+#   open_blend(path), save_blend(path) -> absolute path
+#   result_line(payload) -> "GLOFFUSE_RESULT {...}"
+#   run_main(main) -> runs main with the error handling described there
+# ---------------------------------------------------------------------------
+import argparse
+import json
+import os
+import sys
+import traceback
+
+import bpy
+
+def running_in_blender_binary():
+    """True inside the blender executable (its Text Editor or --python),
+    False when Blender is imported as the `bpy` module."""
+    return bool(bpy.app.binary_path)
+
+
+def script_args(argv=None):
+    """The arguments meant for the script: those after "--" if present;
+    otherwise none inside the blender binary (Text Editor, or --python
+    without "--"), and argv[1:] under a plain Python with the bpy module."""
+    argv = list(sys.argv if argv is None else argv)
+    if "--" in argv:
+        return argv[argv.index("--") + 1:]
+    if running_in_blender_binary():
+        return []
+    return argv[1:]
+
+
+class ArgumentError(ValueError):
+    """Bad command-line arguments for a gloffuse script."""
+
+
+class ScriptArgumentParser(argparse.ArgumentParser):
+    """argparse that raises ArgumentError instead of exiting, so a mistake
+    never quits an interactive Blender."""
+
+    def error(self, message):
+        raise ArgumentError("%s: %s\n%s" % (self.prog, message, self.format_usage().strip()))
+
+
+def parse_script_args(parser, argv=None):
+    """Parse the script's arguments. Headless: strictly. Interactive (the Text
+    Editor of a Blender that may have been started with other arguments after
+    "--"): unknown arguments are reported and ignored."""
+    args = script_args(argv)
+    if bpy.app.background:
+        return parser.parse_args(args)
+    options, ignored = parser.parse_known_args(args)
+    if ignored:
+        sys.stderr.write("%s: ignoring arguments %s\n" % (parser.prog, " ".join(ignored)))
+    return options
+
+
+def open_blend(path):
+    path = os.path.abspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError("no .blend file at %s" % path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    return path
+
+
+def save_blend(path):
+    """Save the open file as `path` without a .blend1 backup (the caller
+    handles backups and atomic renames)."""
+    path = os.path.abspath(path)
+    directory = os.path.dirname(path)
+    if directory and not os.path.isdir(directory):
+        raise FileNotFoundError("the folder %s does not exist" % directory)
+    filepaths = bpy.context.preferences.filepaths
+    old_versions = filepaths.save_version
+    filepaths.save_version = 0
+    try:
+        result = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False,
+                                             copy=False, compress=False)
+    finally:
+        filepaths.save_version = old_versions
+    if "FINISHED" not in result or not os.path.isfile(path):
+        raise RuntimeError("Blender could not save %s" % path)
+    return path
+
+
+def result_line(payload):
+    """The one machine-readable line a main prints on stdout."""
+    return "GLOFFUSE_RESULT " + json.dumps(payload, sort_keys=True)
+
+
+def run_main(main):
+    """Run main(); on error print the traceback and, headless, exit 1 (2 for
+    bad arguments), because blender -b --python ignores exceptions unless
+    --python-exit-code is given. Interactive (Text Editor) the exception is
+    re-raised so Blender shows it and keeps running."""
+    try:
+        main()
+    except ArgumentError as error:
+        sys.stderr.write("%s\n" % error)
+        sys.stderr.flush()
+        if bpy.app.background:
+            sys.exit(2)
+        raise
+    except Exception:
+        traceback.print_exc()
+        sys.stderr.flush()
+        if bpy.app.background:
+            sys.stdout.flush()
+            sys.exit(1)
+        raise

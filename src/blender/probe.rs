@@ -1,0 +1,277 @@
+//! Probing a program: is it a Blender executable or a Python that imports bpy, and which
+//! version? A version probe is one short run with a timeout.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use super::environment::{ENV_VAR, venv_python, which};
+use super::process::{Exit, run_captured, shell_join};
+use crate::Error;
+use crate::measure::BlenderVersion;
+
+/// How long a version probe may take (a cold Blender start on a slow disk can take a while).
+pub const PROBE_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// Printed by the bpy probe in front of `bpy.app.version_string`.
+const BPY_MARKER: &str = "GLOFFUSE_BPY_VERSION ";
+
+/// How a Blender is run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlenderKind {
+    /// A `blender` executable: `blender -b … --python SCRIPT -- ARGS`.
+    Binary,
+    /// A Python interpreter that imports `bpy`: `python SCRIPT ARGS`.
+    PythonModule,
+}
+
+/// A working Blender, 3.0 or later.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Blender {
+    pub kind: BlenderKind,
+    pub program: PathBuf,
+    pub version: BlenderVersion,
+    /// As Blender reports it, e.g. `4.5.4 LTS` or `3.4.1`.
+    pub version_string: String,
+}
+
+impl Blender {
+    /// E.g. `Blender 4.5.4 LTS (bpy module, /opt/bpy45/bin/python)`.
+    pub fn describe(&self) -> String {
+        let kind = match self.kind {
+            BlenderKind::Binary => "executable",
+            BlenderKind::PythonModule => "bpy module",
+        };
+        format!(
+            "Blender {} ({kind}, {})",
+            self.version_string,
+            self.program.display()
+        )
+    }
+}
+
+/// Where a candidate came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// `--blender PATH`.
+    Explicit,
+    /// `$GLOFFUSE_BLENDER`.
+    EnvVar,
+    /// `blender` on `PATH`.
+    SystemPath,
+    /// The provisioned bpy venv.
+    Cache,
+}
+
+impl std::fmt::Display for Source {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Source::Explicit => "--blender",
+            Source::EnvVar => ENV_VAR,
+            Source::SystemPath => "`blender` on PATH",
+            Source::Cache => "the bpy cache",
+        })
+    }
+}
+
+/// Probes `program` and says what Blender it is, whichever kind it is.
+///
+/// Tries it as a `blender` executable (`-b --factory-startup -noaudio --version`), then as a
+/// Python that imports bpy (a name starting with `python` is tried that way first). A
+/// directory is looked into for `blender` or a venv's `bin/python`.
+pub fn probe(program: &Path) -> Result<Blender, Error> {
+    probe_as(program, None, Source::Explicit)
+}
+
+pub(super) fn probe_as(
+    program: &Path,
+    kind: Option<BlenderKind>,
+    source: Source,
+) -> Result<Blender, Error> {
+    let named =
+        |what: &str| Error::BlenderNotFound(format!("{source} {}: {what}", program.display()));
+    let program = if program.is_dir() {
+        [program.join("blender"), venv_python(program)]
+            .into_iter()
+            .find(|p| p.is_file())
+            .ok_or_else(|| {
+                named("is a directory without `blender` or `bin/python` in it; give the blender executable or the Python that imports bpy")
+            })?
+    } else if program.is_file() {
+        program.to_path_buf()
+    } else if program.exists() || program.symlink_metadata().is_ok() {
+        return Err(named("is not a file (a broken link?)"));
+    } else if let Some(found) = program
+        .to_str()
+        .filter(|s| !s.contains('/'))
+        .and_then(|name| which(name, std::env::var_os("PATH").as_deref()))
+    {
+        // A bare command name (`--blender blender`, `--blender python3`) is looked up on PATH.
+        found
+    } else {
+        return Err(named("no such file (nor a command of that name on PATH)"));
+    };
+    // Absolute (but with symlinks kept: a venv's python must stay in its venv), so the
+    // rerun command printed for a failure works from any directory.
+    let program = std::path::absolute(&program).unwrap_or(program);
+    let looks_like_python = program
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().starts_with("python"));
+    let order: &[BlenderKind] = match kind {
+        Some(BlenderKind::Binary) => &[BlenderKind::Binary],
+        Some(BlenderKind::PythonModule) => &[BlenderKind::PythonModule],
+        None if looks_like_python => &[BlenderKind::PythonModule, BlenderKind::Binary],
+        None => &[BlenderKind::Binary, BlenderKind::PythonModule],
+    };
+    let mut tried = Vec::new();
+    for &k in order {
+        match probe_kind(&program, k)? {
+            Probed::Found(b) => return Ok(b),
+            Probed::Not(attempt) => {
+                // Something that answered like Blender must not then be fed Python code:
+                // an old Blender would take `-c CODE` for a file and open its window.
+                let blenderish = k == BlenderKind::Binary && attempt.output.contains("Blender");
+                tried.push(attempt);
+                if blenderish {
+                    break;
+                }
+            }
+        }
+    }
+    let mut m = format!(
+        "{source} {} is neither a working Blender ({} or later) nor a Python that imports bpy",
+        program.display(),
+        BlenderVersion::OLDEST
+    );
+    for t in &tried {
+        m.push_str(&format!("\n  `{}` {}", t.command, t.outcome));
+        for line in last_lines(&t.output, 6) {
+            m.push_str("\n      ");
+            m.push_str(line);
+        }
+    }
+    Err(Error::Blender {
+        message: m,
+        log: None,
+        command: None,
+    })
+}
+
+struct Attempt {
+    command: String,
+    outcome: String,
+    output: String,
+}
+
+enum Probed {
+    Found(Blender),
+    Not(Attempt),
+}
+
+/// Runs one version probe. `Ok(Not)`: it did not answer as this kind. `Err`: it did, but
+/// as a Blender older than 3.0.
+fn probe_kind(program: &Path, kind: BlenderKind) -> Result<Probed, Error> {
+    let mut argv: Vec<OsString> = vec![program.as_os_str().to_owned()];
+    match kind {
+        BlenderKind::Binary => {
+            argv.extend(["-b", "--factory-startup", "-noaudio", "--version"].map(OsString::from))
+        }
+        BlenderKind::PythonModule => argv.extend(
+            [
+                "-c",
+                &format!("import bpy, sys; print({BPY_MARKER:?} + bpy.app.version_string)"),
+            ]
+            .map(OsString::from),
+        ),
+    }
+    let command = shell_join(&argv);
+    let not = |outcome: String, output: String| {
+        Ok(Probed::Not(Attempt {
+            command: command.clone(),
+            outcome,
+            output,
+        }))
+    };
+    let (exit, output) = match run_captured(&argv, PROBE_TIMEOUT) {
+        Ok(r) => r,
+        Err(e) => return not(format!("could not be run: {e}"), String::new()),
+    };
+    match exit {
+        Exit::TimedOut => {
+            return not(
+                format!("did not answer within {} s", PROBE_TIMEOUT.as_secs()),
+                output,
+            );
+        }
+        Exit::Finished(s) if !s.success() => return not(format!("failed ({s})"), output),
+        Exit::Finished(_) => {}
+    }
+    let reported = match kind {
+        BlenderKind::Binary => output
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("Blender ")),
+        BlenderKind::PythonModule => output
+            .lines()
+            .find_map(|l| l.trim().strip_prefix(BPY_MARKER)),
+    };
+    let Some(version_string) = reported.map(str::trim) else {
+        return not("did not report a Blender version".into(), output);
+    };
+    let token = version_string.split_whitespace().next().unwrap_or("");
+    let version = match token.parse::<BlenderVersion>() {
+        Ok(v) => v,
+        Err(_) if is_old_version(token) => {
+            return Err(Error::Blender {
+                message: format!(
+                    "{} is Blender {version_string}; gloffuse needs Blender {} or later \
+                     (older Glossy BSDFs are not modelled)",
+                    program.display(),
+                    BlenderVersion::OLDEST
+                ),
+                log: None,
+                command: Some(command),
+            });
+        }
+        Err(_) => {
+            return not(
+                format!("reported an unrecognised version '{version_string}'"),
+                output,
+            );
+        }
+    };
+    Ok(Probed::Found(Blender {
+        kind,
+        program: program.to_path_buf(),
+        version,
+        version_string: version_string.to_string(),
+    }))
+}
+
+/// `2.79`, `2.93.1`: a well-formed version below 3.0.
+fn is_old_version(token: &str) -> bool {
+    let mut parts = token.split('.');
+    let major = parts.next().and_then(|p| p.parse::<u32>().ok());
+    let minor_ok = parts
+        .next()
+        .is_some_and(|p| !p.is_empty() && p.chars().take_while(char::is_ascii_digit).count() > 0);
+    matches!(major, Some(m) if m < BlenderVersion::OLDEST.major) && minor_ok
+}
+
+pub(super) fn last_lines(text: &str, n: usize) -> Vec<&str> {
+    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    lines[lines.len().saturating_sub(n)..].to_vec()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn old_versions_are_recognised() {
+        assert!(is_old_version("2.79"));
+        assert!(is_old_version("2.93.1"));
+        assert!(!is_old_version("3.4.1"));
+        assert!(!is_old_version("2"));
+        assert!(!is_old_version("two.79"));
+    }
+}

@@ -1,0 +1,154 @@
+//! Process spawning: a child in its own process group with its output in a file, a
+//! timeout that kills the whole group, and shell quoting for the commands gloffuse prints.
+
+use std::ffi::{OsStr, OsString};
+use std::fs::File;
+use std::io;
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+/// How a child ended.
+#[derive(Debug)]
+pub enum Exit {
+    Finished(ExitStatus),
+    /// The timeout passed; the child's process group was killed and the child reaped.
+    TimedOut,
+}
+
+/// Runs `argv` in a process group of its own, stdin from /dev/null, stdout and stderr both
+/// to `out`, and waits at most `timeout`. On timeout the whole group is killed (SIGKILL)
+/// and the child reaped, so neither it nor its children outlive the call.
+pub fn run_logged(argv: &[OsString], out: &File, timeout: Duration) -> io::Result<Exit> {
+    let (program, args) = argv
+        .split_first()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "empty command"))?;
+    let mut cmd = Command::new(program);
+    cmd.args(args)
+        .stdin(Stdio::null())
+        .stdout(out.try_clone()?)
+        .stderr(out.try_clone()?)
+        // Unbuffered Python: the log is in order and nothing is lost if Blender crashes.
+        .env("PYTHONUNBUFFERED", "1")
+        .process_group(0);
+    die_with_parent(&mut cmd);
+    let mut child = cmd.spawn()?;
+    let start = Instant::now();
+    let mut pause = Duration::from_millis(2);
+    loop {
+        if let Some(status) = child.try_wait()? {
+            return Ok(Exit::Finished(status));
+        }
+        let elapsed = start.elapsed();
+        if elapsed >= timeout {
+            // The group id is the child's pid (process_group(0)); the child is not yet
+            // reaped, so the id cannot have been reused.
+            let killed = match libc::pid_t::try_from(child.id()) {
+                // SAFETY: killpg only sends a signal; it touches no memory of ours.
+                Ok(pgid) => (unsafe { libc::killpg(pgid, libc::SIGKILL) }) == 0,
+                Err(_) => false,
+            };
+            if !killed {
+                let _ = child.kill();
+            }
+            child.wait()?;
+            return Ok(Exit::TimedOut);
+        }
+        std::thread::sleep(pause.min(timeout - elapsed));
+        pause = (pause * 2).min(Duration::from_millis(50));
+    }
+}
+
+/// Asks Linux to kill the child when gloffuse dies (a child in its own process group does
+/// not get the terminal's Ctrl-C), so an interrupted gloffuse leaves no Blender behind.
+#[cfg(target_os = "linux")]
+fn die_with_parent(cmd: &mut Command) {
+    let parent = std::process::id();
+    // SAFETY: the closure runs between fork and exec and calls only async-signal-safe
+    // functions (prctl, getppid); it allocates nothing.
+    unsafe {
+        cmd.pre_exec(move || {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) == -1 {
+                return Err(io::Error::last_os_error());
+            }
+            // The parent may have died before prctl took effect.
+            if u32::try_from(libc::getppid()).ok() != Some(parent) {
+                return Err(io::Error::from_raw_os_error(libc::ESRCH));
+            }
+            Ok(())
+        });
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn die_with_parent(_cmd: &mut Command) {}
+
+/// Runs a short command with a timeout and returns its stdout and stderr (together, lossy).
+pub fn run_captured(argv: &[OsString], timeout: Duration) -> io::Result<(Exit, String)> {
+    let out = tempfile::tempfile()?;
+    let exit = run_logged(argv, &out, timeout)?;
+    let mut out = out;
+    let mut bytes = Vec::new();
+    use std::io::{Read, Seek};
+    out.rewind()?;
+    out.read_to_end(&mut bytes)?;
+    Ok((exit, String::from_utf8_lossy(&bytes).into_owned()))
+}
+
+/// `exited with status 1`, `was killed by signal 9`.
+pub fn describe_status(status: ExitStatus) -> String {
+    match (status.code(), status.signal()) {
+        (Some(code), _) => format!("exited with status {code}"),
+        (None, Some(sig)) => format!("was killed by signal {sig}"),
+        (None, None) => format!("ended abnormally ({status})"),
+    }
+}
+
+/// `2`, `0.5`, `90` — seconds as a person writes them on the command line.
+pub fn format_seconds(d: Duration) -> String {
+    if d.subsec_nanos() == 0 {
+        d.as_secs().to_string()
+    } else {
+        format!("{}", (d.as_secs_f64() * 1000.0).round() / 1000.0)
+    }
+}
+
+/// Joins arguments into one POSIX-shell command line (arguments with anything beyond
+/// `[A-Za-z0-9_@%+=:,./-]` are single-quoted; bad UTF-8 is shown lossily).
+pub fn shell_join(argv: &[OsString]) -> String {
+    argv.iter()
+        .map(|a| shell_quote(a))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Quotes one argument for a POSIX shell.
+///
+/// ```
+/// use gloffuse::blender::process::shell_quote;
+/// assert_eq!(shell_quote("/usr/bin/blender".as_ref()), "/usr/bin/blender");
+/// assert_eq!(shell_quote("it's here".as_ref()), r"'it'\''s here'");
+/// assert_eq!(shell_quote("".as_ref()), "''");
+/// ```
+pub fn shell_quote(arg: &OsStr) -> String {
+    let s = arg.to_string_lossy();
+    let safe = |c: char| c.is_ascii_alphanumeric() || "_@%+=:,./-".contains(c);
+    if !s.is_empty() && s.chars().all(safe) {
+        s.into_owned()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seconds_and_quoting() {
+        assert_eq!(format_seconds(Duration::from_secs(2)), "2");
+        assert_eq!(format_seconds(Duration::from_millis(1500)), "1.5");
+        let argv: Vec<OsString> = vec!["blender".into(), "--".into(), "a b".into(), "$x".into()];
+        assert_eq!(shell_join(&argv), "blender -- 'a b' '$x'");
+    }
+}

@@ -1,0 +1,195 @@
+//! Installing bpy (Blender as a Python module) into the per-user cache when no Blender is
+//! found: a venv made under a temporary name, `pip install`, a probe, and only then a rename
+//! into place.
+
+use std::ffi::OsString;
+use std::fs::File;
+use std::os::fd::AsFd;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use super::environment::{BPY_REQUIREMENT, BPY_SERIES, ENV_VAR, Environment, venv_python, which};
+use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, last_lines, probe_as};
+use super::process::{Exit, run_captured, shell_join};
+use crate::Error;
+use crate::progress::Progress;
+
+/// Where the installer's (venv's and pip's) output goes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum InstallerOutput {
+    /// To `bpy-4.5-install.log` beside the venv, quoted in the error if the install fails.
+    #[default]
+    Log,
+    /// To this process's stderr (never stdout, which may carry JSON), so a person sees
+    /// pip's own progress.
+    Stderr,
+}
+
+/// Installs bpy into `venv`: a venv made in a temporary sibling directory, `pip install`,
+/// a probe, and only then a rename into place — an interrupted install leaves only a
+/// `.bpy-4.5.partial-*` directory, never a `bpy-4.5` that looks valid. `skipped` names
+/// the Blenders that were found but could not be used; they are announced through
+/// `progress` with the install.
+pub(super) fn provision(
+    venv: &Path,
+    env: &Environment,
+    output: InstallerOutput,
+    skipped: &[String],
+    progress: &dyn Progress,
+) -> Result<Blender, Error> {
+    let quiet = output == InstallerOutput::Log;
+    let parent = venv.parent().unwrap_or(Path::new("."));
+    let write_err = |path: &Path, e: &dyn std::fmt::Display| Error::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    // Fail before announcing or creating anything if the install cannot work.
+    let python = base_python(env)?;
+    std::fs::create_dir_all(parent).map_err(|e| write_err(parent, &e))?;
+    for s in skipped {
+        progress.notice(&format!("not using {s}"));
+    }
+    progress.notice(&format!(
+        "no Blender found; installing bpy {BPY_SERIES} LTS (Blender as a Python \
+         module, ~370 MB) into {} — point --blender or {ENV_VAR} at a Blender to skip this",
+        venv.display()
+    ));
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".bpy-{BPY_SERIES}.partial-"))
+        .tempdir_in(parent)
+        .map_err(|e| write_err(parent, &e))?;
+    let log_path = parent.join(format!("bpy-{BPY_SERIES}-install.log"));
+    let step = |argv: Vec<OsString>| -> Result<(), Error> {
+        let command = shell_join(&argv);
+        let mut cmd = Command::new(&argv[0]);
+        cmd.args(&argv[1..]).stdin(Stdio::null());
+        let (out, log) = if quiet {
+            let f = File::create(&log_path).map_err(|e| write_err(&log_path, &e))?;
+            (f, Some(log_path.clone()))
+        } else {
+            let fd = std::io::stderr()
+                .as_fd()
+                .try_clone_to_owned()
+                .map_err(|e| write_err(Path::new("<stderr>"), &e))?;
+            (File::from(fd), None)
+        };
+        let status = cmd
+            .stdout(
+                out.try_clone()
+                    .map_err(|e| write_err(Path::new("<stderr>"), &e))?,
+            )
+            .stderr(out)
+            .status();
+        let fail = |what: String| {
+            let mut message = format!(
+                "installing bpy {BPY_SERIES} into {} failed: {what}",
+                venv.display()
+            );
+            if let Some(l) = &log {
+                let text = std::fs::read(l)
+                    .map(|b| String::from_utf8_lossy(&b).into_owned())
+                    .unwrap_or_default();
+                for line in last_lines(&text, 8) {
+                    message.push_str("\n    ");
+                    message.push_str(line);
+                }
+            }
+            message.push_str(&format!(
+                "\n  (bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or point \
+                 --blender or {ENV_VAR} at a Blender)"
+            ));
+            Error::Blender {
+                message,
+                log: log.clone(),
+                command: Some(command.clone()),
+            }
+        };
+        match status {
+            Ok(s) if s.success() => Ok(()),
+            Ok(s) => Err(fail(format!("{s}"))),
+            Err(e) => Err(fail(e.to_string())),
+        }
+    };
+    let mut make_venv: Vec<OsString> = vec![python.into_os_string()];
+    make_venv.extend(["-m", "venv"].map(OsString::from));
+    make_venv.push(tmp.path().as_os_str().to_owned());
+    step(make_venv)?;
+    let tmp_python = venv_python(tmp.path());
+    let mut pip: Vec<OsString> = vec![tmp_python.clone().into_os_string()];
+    pip.extend(
+        [
+            "-m",
+            "pip",
+            "install",
+            "--disable-pip-version-check",
+            "--no-input",
+        ]
+        .map(OsString::from),
+    );
+    if quiet {
+        pip.push("-q".into());
+    }
+    pip.push(BPY_REQUIREMENT.into());
+    step(pip)?;
+    // Check the install before it is given the name that makes it look valid.
+    probe_as(&tmp_python, Some(BlenderKind::PythonModule), Source::Cache)?;
+    if let Err(e) = std::fs::rename(tmp.path(), venv) {
+        // Another gloffuse may have finished first; use its venv (ours is removed on drop).
+        if !venv_python(venv).exists() {
+            return Err(write_err(venv, &e));
+        }
+    } else {
+        let _ = tmp.keep();
+    }
+    match probe_as(
+        &venv_python(venv),
+        Some(BlenderKind::PythonModule),
+        Source::Cache,
+    ) {
+        Ok(b) => Ok(b),
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(venv);
+            Err(e)
+        }
+    }
+}
+
+/// A Python 3.11 to make the venv with (bpy 4.5 wheels are for CPython 3.11 only):
+/// `python3.11`, else `python3` if it is 3.11.
+fn base_python(env: &Environment) -> Result<PathBuf, Error> {
+    let mut seen = Vec::new();
+    for name in ["python3.11", "python3"] {
+        let Some(p) = which(name, env.path.as_deref()) else {
+            continue;
+        };
+        let argv: Vec<OsString> = vec![
+            p.clone().into_os_string(),
+            "-c".into(),
+            "import sys; print('%d.%d' % sys.version_info[:2])".into(),
+        ];
+        if let Ok((Exit::Finished(s), out)) = run_captured(&argv, PROBE_TIMEOUT) {
+            let v = out
+                .lines()
+                .map(str::trim)
+                .rfind(|l| {
+                    l.split('.')
+                        .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+                })
+                .unwrap_or("?");
+            if s.success() && v == "3.11" {
+                return Ok(p);
+            }
+            seen.push(format!("{} is Python {v}", p.display()));
+        }
+    }
+    Err(Error::BlenderNotFound(format!(
+        "no Blender found, and bpy {BPY_SERIES} cannot be installed: it needs CPython 3.11 \
+         (python3.11 or python3 on PATH){}. Install python3.11, or point --blender or \
+         {ENV_VAR} at a Blender (apt-get install blender).",
+        if seen.is_empty() {
+            String::new()
+        } else {
+            format!("; found {}", seen.join(", "))
+        }
+    )))
+}

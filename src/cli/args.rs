@@ -1,0 +1,834 @@
+//! The command line: clap definitions (each flag documented once, here) and the one place
+//! that turns typed flags into the library's option structs. Every default is taken from
+//! the library's `Default`s, so it is written once.
+
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use std::time::Duration;
+
+use gloffuse::bench::BenchOptions;
+use gloffuse::blender::{BlenderOptions, InstallerOutput};
+use gloffuse::fit::{Point, Target, Weighting};
+use gloffuse::generate::{GenerateOptions, Mode};
+use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Sampling};
+use gloffuse::measure::brdf::{Model, ModelParams};
+use gloffuse::measure::{BlenderVersion, Distribution, Roughness};
+use gloffuse::refresh::RefreshOptions;
+use gloffuse::verify::{Judging, RenderSettings, VerifyOptions};
+
+const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
+const LONG_ABOUT: &str = "\
+Blender's single-scattering glossy BSDFs (Beckmann, GGX, Ashikhmin-Shirley) lose energy as \
+roughness grows: a white glossy sphere under a white sky should be 100 % bright but comes out \
+far darker when rough. gloffuse measures that loss by integrating exactly the BSDF Cycles \
+evaluates, fits correction curves f(r) (the shader gain is 100/f(r)), builds Blender node groups \
+that apply them, and checks them by rendering white furnace spheres in Blender headless.
+
+Exit codes: 0 success; 1 a check failed (verify, refresh); 2 an error: bad input (the message \
+names the flag or file and what would be right), no Blender found (it says where gloffuse \
+looked and how to point at one), Blender failed or timed out (the message quotes its log, \
+names the log file and prints the command to rerun it), or an output could not be written \
+(nothing half-written is ever left behind).";
+
+#[derive(Parser, Debug)]
+#[command(name = "gloffuse", version, about = ABOUT, long_about = LONG_ABOUT)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Albedo of a white Glossy BSDF: E(μ, r) for one view, E_avg(r) for a whole sphere.
+    ///
+    /// E(μ, r) is the fraction of light a white glossy surface of roughness r reflects toward
+    /// a viewer at view cosine μ under a uniform white sky (the centre of a furnace sphere is
+    /// μ = 1). E_avg(r) = 2∫E(μ)μdμ is the mean brightness of the whole sphere.
+    Albedo(AlbedoArgs),
+    /// Fit a correction curve f(r) = 100 + c₂r² + c₃r³ + … (f(0) = 100, f'(0) = 0).
+    ///
+    /// Fits brightness points given by hand (--point ROUGHNESS:PERCENT), or all three
+    /// distributions from the integrator (--from integrator) into a coefficients file. The
+    /// shader gain that restores 100 % is 100/f(r).
+    Fit(FitArgs),
+    /// Write the brightness-correction node groups: a Python script, a new .blend, or into a .blend.
+    ///
+    /// Builds `Brightness Correction (…)` (gain = 100/f(r)) and `Gloffuse (…)` (a Glossy BSDF
+    /// driven by the corrected colour) for each distribution in the coefficients. --script
+    /// needs no Blender; --blend and --into run Blender headless (found or installed
+    /// automatically, see --blender).
+    Generate(GenerateArgs),
+    /// Render furnace spheres in Blender and check that corrected ones come out at 100 %.
+    ///
+    /// One headless Blender process renders, for each distribution and roughness, a white
+    /// sphere under a uniform white sky with the plain Glossy BSDF and with the `Gloffuse (…)`
+    /// group built by the same script `generate` writes, plus Blender's own Multiscatter GGX
+    /// as a reference. A sphere's mean brightness (Σ RGB / Σ alpha) must be 100 % ± tolerance.
+    /// Exit code 0: all corrected spheres pass; 1: some failed; 2: bad input or Blender error.
+    Verify(VerifyArgs),
+    /// Measure E_avg in your Blender, fit new coefficients from it, then verify them.
+    ///
+    /// Renders plain Glossy furnace spheres of every distribution on a roughness grid, fits
+    /// f(r) to their mean brightness with the same fitter as `fit`, writes a coefficients
+    /// file whose provenance names this Blender, compares the measurement with the
+    /// integrator's prediction (a disagreement above 0.5 % is a warning), and runs `verify`
+    /// with the new file.
+    Refresh(RefreshArgs),
+    /// Write a lookup table for real-time renderers: the split-sum LUT or Kulla–Conty's.
+    ///
+    /// split-sum: the GGX "BRDF generator" texture (R = scale, G = bias; specular =
+    /// F0·scale + bias). kulla-conty: for the Glossy BSDF Cycles evaluates, scale, bias,
+    /// the missing multiple-scattering energy ∫f_ms cos and E_avg (RGBA), so a renderer can
+    /// add back what single scattering loses. albedo: that BSDF's E(μ, r) and E_avg(r).
+    /// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n, first row first; written
+    /// as EXR, DDS (DX10) or KTX 2.0, half or float.
+    Lut(LutArgs),
+    /// Time the verify sweep as one Blender process against one process per sphere.
+    Bench(BenchArgs),
+    /// Inspect coefficient files and the built-in presets.
+    Coefficients {
+        #[command(subcommand)]
+        action: CoefficientsCommand,
+    },
+}
+
+// ---------------------------------------------------------------------------------------
+// Value parsers
+
+/// One value of an enumerated flag: the value, its help, and another spelling it accepts.
+pub struct Choice<T: 'static> {
+    value: T,
+    help: &'static str,
+    alias: Option<&'static str>,
+}
+
+const fn choice<T>(value: T, help: &'static str) -> Choice<T> {
+    Choice {
+        value,
+        help,
+        alias: None,
+    }
+}
+
+/// A parser for one of `choices`, spelled as `key` names them (the library's spelling, so
+/// the command line and the files agree); `--help` lists each with its help.
+fn one_of<T: Copy + Send + Sync + 'static>(
+    choices: &'static [Choice<T>],
+    key: fn(T) -> &'static str,
+) -> impl TypedValueParser<Value = T> {
+    let values = choices.iter().map(move |c| {
+        let v = PossibleValue::new(key(c.value)).help(c.help);
+        match c.alias {
+            Some(a) => v.alias(a),
+            None => v,
+        }
+    });
+    PossibleValuesParser::new(values).map(move |name| {
+        choices
+            .iter()
+            .find(|c| key(c.value) == name || c.alias == Some(name.as_str()))
+            .map(|c| c.value)
+            .expect("clap only passes a listed value")
+    })
+}
+
+const MODES: &[Choice<Mode>] = &[
+    choice(
+        Mode::Roughness,
+        "gain 100/f(r): the sphere's mean is 100 %, its centre darker, its rim brighter",
+    ),
+    choice(
+        Mode::View,
+        "gain 1/E(μ, r) with μ = N·I: every pixel of a furnace sphere is 100 %",
+    ),
+    choice(
+        Mode::Multiscatter,
+        "Glossy plus a diffuse lobe of colour × (1 − E(μ, r)): every pixel 100 %, highlight unchanged",
+    ),
+];
+
+const TARGETS: &[Choice<Target>] = &[
+    choice(
+        Target::Mean,
+        "E_avg(r): the mean brightness of an evenly lit sphere",
+    ),
+    choice(
+        Target::Center,
+        "E(1, r): the brightness at the centre of the sphere (view along the normal)",
+    ),
+];
+
+const WEIGHTINGS: &[Choice<Weighting>] = &[
+    choice(
+        Weighting::Absolute,
+        "minimise the error in brightness points",
+    ),
+    choice(
+        Weighting::Relative,
+        "minimise the relative error f/y − 1, i.e. the gain error (right for a gain)",
+    ),
+];
+
+const KINDS: &[Choice<Kind>] = &[
+    choice(Kind::SplitSum, "GGX split-sum (R = scale, G = bias)"),
+    choice(
+        Kind::KullaConty,
+        "Kulla–Conty for a Cycles Glossy BSDF (R = scale, G = bias, B = ∫f_ms cos, A = E_avg)",
+    ),
+    choice(
+        Kind::Albedo,
+        "Kulla–Conty's albedo tables for a Cycles Glossy BSDF (R = E(μ, r), G = E_avg(r))",
+    ),
+];
+
+const G_MODELS: &[Choice<GModel>] = &[
+    choice(
+        GModel::Ue4,
+        "separable Schlick-GGX with k = α/2 (Karis' UE4 table)",
+    ),
+    choice(
+        GModel::HeightCorrelated,
+        "Smith GGX height-correlated, G2 = 1/(1 + Λ(V) + Λ(L)) (Cycles 3.6+, Filament)",
+    ),
+];
+
+const SAMPLINGS: &[Choice<Sampling>] = &[
+    choice(
+        Sampling::VisibleNormals,
+        "GGX visible normals (Heitz 2018): bounded weights, 1e-3 at 2048 samples",
+    ),
+    choice(
+        Sampling::Classic,
+        "the textbook (UE4) estimator to the letter: H ~ D·N·H; up to 1e-2 off near grazing at 1024",
+    ),
+];
+
+const FORMATS: &[Choice<Format>] = &[
+    choice(Format::Exr, "OpenEXR, ZIP-compressed scan lines"),
+    choice(Format::Dds, "DirectDraw Surface with a DX10 header"),
+    Choice {
+        value: Format::Ktx,
+        help: "KTX 2.0 (not KTX 1)",
+        alias: Some("ktx"),
+    },
+];
+
+const BITS: &[Choice<Bits>] = &[
+    choice(
+        Bits::Half,
+        "IEEE half floats (what GPUs sample fastest; rounding error ≤ 2.5e-4 below 1)",
+    ),
+    choice(
+        Bits::Float,
+        "IEEE single floats (exactly the computed values)",
+    ),
+];
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FitSource {
+    /// gloffuse's integrator (exactly the BSDF Cycles evaluates).
+    Integrator,
+}
+
+fn parse_distribution(s: &str) -> Result<Distribution, String> {
+    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+}
+
+fn parse_model(s: &str) -> Result<Model, String> {
+    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+}
+
+fn parse_roughness(s: &str) -> Result<Roughness, String> {
+    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+}
+
+fn parse_version(s: &str) -> Result<BlenderVersion, String> {
+    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+}
+
+fn parse_point(s: &str) -> Result<Point, String> {
+    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+}
+
+fn parse_mu(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 1.0 => Ok(v),
+        _ => Err(format!(
+            "invalid view cosine '{s}': expected a number in (0, 1], e.g. 1 or 0.5"
+        )),
+    }
+}
+
+fn parse_tolerance(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 100.0 => Ok(v),
+        _ => Err(format!(
+            "invalid tolerance '{s}': expected a percentage above 0 and at most 100, e.g. 1"
+        )),
+    }
+}
+
+fn verify_defaults() -> VerifyOptions {
+    VerifyOptions::default()
+}
+
+fn refresh_defaults() -> RefreshOptions {
+    RefreshOptions::default()
+}
+
+// ---------------------------------------------------------------------------------------
+// Commands
+
+#[derive(Args, Debug)]
+pub struct AlbedoArgs {
+    /// beckmann, ggx or ashikhmin-shirley (case-insensitive; BECKMANN, GGX, ASHIKHMIN_SHIRLEY work too).
+    #[arg(long, short = 'd', value_parser = parse_distribution, required_unless_present = "model")]
+    pub distribution: Option<Distribution>,
+
+    /// A classic BRDF instead of Blender's Glossy: lambert, phong (normalised modified Phong),
+    /// ward (anisotropic), cook-torrance (Beckmann D, Schlick Fresnel), fresnel-blend
+    /// (Ashikhmin–Shirley's diffuse term). Parameters: --rho, --rs, --exponent, --alpha-x, --alpha-y.
+    #[arg(long, value_parser = parse_model, conflicts_with_all = ["distribution", "roughness", "table"])]
+    pub model: Option<Model>,
+
+    /// --model: reflectance ρ (Lambert), ρs (Phong, Ward), f0 (Cook–Torrance) or Rd (Fresnel blend).
+    #[arg(long, default_value_t = ModelParams::default().rho, allow_hyphen_values = true)]
+    pub rho: f64,
+
+    /// --model fresnel-blend: specular reflectance Rs at normal incidence.
+    #[arg(long, default_value_t = ModelParams::default().rs, allow_hyphen_values = true)]
+    pub rs: f64,
+
+    /// --model phong: the exponent n.
+    #[arg(long, default_value_t = ModelParams::default().exponent, allow_hyphen_values = true)]
+    pub exponent: f64,
+
+    /// --model ward: αx (along the tangent); --model cook-torrance: α.
+    #[arg(long, default_value_t = ModelParams::default().alpha_x, allow_hyphen_values = true)]
+    pub alpha_x: f64,
+
+    /// --model ward: αy (along the bitangent).
+    #[arg(long, default_value_t = ModelParams::default().alpha_y, allow_hyphen_values = true)]
+    pub alpha_y: f64,
+
+    /// The Glossy node's Roughness, 0 to 1 (Cycles uses alpha = r²).
+    #[arg(long, short = 'r', value_parser = parse_roughness, allow_hyphen_values = true)]
+    pub roughness: Option<Roughness>,
+
+    /// View cosine μ = N·V in (0, 1]; 1 looks straight at the surface (a sphere's centre).
+    #[arg(long, default_value = "1", value_parser = parse_mu, allow_hyphen_values = true)]
+    pub mu: f64,
+
+    /// Blender version whose masking to model: 3.0–3.5 separable, 3.6 and later height-correlated.
+    #[arg(long, default_value_t = BlenderVersion::DEFAULT, value_parser = parse_version)]
+    pub blender_version: BlenderVersion,
+
+    /// Write a CSV grid instead: roughness j/(N−1) for j < N, μ = (i + ½)/N for i < N.
+    #[arg(long, value_name = "FILE.csv")]
+    pub table: Option<PathBuf>,
+
+    /// Grid size N for --table.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=4096))]
+    pub grid: u32,
+
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl AlbedoArgs {
+    pub fn model_params(&self) -> ModelParams {
+        ModelParams {
+            rho: self.rho,
+            rs: self.rs,
+            exponent: self.exponent,
+            alpha_x: self.alpha_x,
+            alpha_y: self.alpha_y,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// Distribution the --point values belong to (beckmann, ggx, ashikhmin-shirley).
+    #[arg(long, short = 'd', value_parser = parse_distribution)]
+    pub distribution: Option<Distribution>,
+
+    /// A measured brightness, ROUGHNESS:PERCENT (e.g. 0.5:97); repeat for more points.
+    #[arg(long = "point", short = 'p', value_name = "R:PERCENT", value_parser = parse_point, conflicts_with = "from", allow_hyphen_values = true)]
+    pub points: Vec<Point>,
+
+    /// Fit every distribution from this source instead of --point values.
+    #[arg(long, value_enum)]
+    pub from: Option<FitSource>,
+
+    /// Polynomial degree in r, 2 to 8 [default: 3 for --point, 6 for --from integrator, the
+    /// lowest degree that keeps every distribution's gain within 0.1 %].
+    #[arg(long)]
+    pub degree: Option<usize>,
+
+    /// Minimise the error in brightness points (absolute) or in the gain 100/f (relative).
+    #[arg(long, value_parser = one_of(WEIGHTINGS, Weighting::key), default_value = Weighting::Relative.key())]
+    pub weighting: Weighting,
+
+    /// With --from integrator: fit the sphere's mean brightness E_avg(r) or its centre E(1, r).
+    #[arg(long, value_parser = one_of(TARGETS, Target::key), default_value = Target::Mean.key())]
+    pub target: Target,
+
+    /// With --from integrator: the Blender version whose masking to model.
+    #[arg(long, default_value_t = BlenderVersion::DEFAULT, value_parser = parse_version)]
+    pub blender_version: BlenderVersion,
+
+    /// Write a coefficients file (written atomically: never half-written).
+    #[arg(long, value_name = "FILE.json")]
+    pub out: Option<PathBuf>,
+
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Where Blender comes from and how long it may run: shared by every command that runs it.
+#[derive(Args, Debug, Clone)]
+pub struct BlenderArgs {
+    /// A Blender executable, or a Python interpreter that imports bpy. Otherwise gloffuse
+    /// tries $GLOFFUSE_BLENDER, `blender` on PATH, then a bpy it installed earlier, and
+    /// finally installs bpy 4.5 LTS into its cache directory.
+    #[arg(long, value_name = "PATH")]
+    pub blender: Option<PathBuf>,
+
+    /// Never install bpy; fail with advice instead when no Blender is found.
+    #[arg(long)]
+    pub no_provision: bool,
+
+    /// Kill Blender (and its children) after this many seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = BlenderOptions::default().timeout.as_secs(),
+          value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    pub timeout: u64,
+}
+
+impl BlenderArgs {
+    /// The options; pip's output goes to the install log when stdout carries JSON (`quiet`).
+    pub fn options(&self, quiet: bool) -> BlenderOptions {
+        BlenderOptions {
+            program: self.blender.clone(),
+            provision: !self.no_provision,
+            installer_output: if quiet {
+                InstallerOutput::Log
+            } else {
+                InstallerOutput::Stderr
+            },
+            timeout: Duration::from_secs(self.timeout),
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    /// A preset (seed, blender-3, blender-4) or a coefficients file [default: the preset of
+    /// the Blender used: blender-3 for 3.0–3.5, blender-4 for 3.6 and later].
+    #[arg(long, value_name = "PRESET|FILE")]
+    pub coefficients: Option<String>,
+
+    /// Write the generated Python script here (no Blender needed). Run it in Blender's
+    /// Text Editor, or `blender -b --python FILE -- --save OUT.blend`.
+    #[arg(long, value_name = "OUT.py")]
+    pub script: Option<PathBuf>,
+
+    /// Write a new .blend library holding the groups (marked as assets).
+    #[arg(long, value_name = "OUT.blend", conflicts_with = "into")]
+    pub blend: Option<PathBuf>,
+
+    /// Add or replace the groups in an existing .blend, in place (materials using them keep
+    /// working); the previous file is kept as FILE.blend1.
+    #[arg(long, value_name = "EXISTING.blend")]
+    pub into: Option<PathBuf>,
+
+    /// Which groups to build besides the roughness-only pair (repeatable): view adds
+    /// `Brightness Correction View (…)` and `Gloffuse View (…)` (gain 1/E(μ, r)), and
+    /// multiscatter adds `Gloffuse Multiscatter (…)`; both add the packed E(μ, r) table.
+    #[arg(long, value_parser = one_of(MODES, Mode::key), value_delimiter = ',', default_value = Mode::Roughness.key())]
+    pub mode: Vec<Mode>,
+
+    /// With only --script: the Blender version whose preset to use by default.
+    #[arg(long, default_value_t = GenerateOptions::default().blender_version, value_parser = parse_version)]
+    pub blender_version: BlenderVersion,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+
+    /// Print a JSON summary instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl GenerateArgs {
+    pub fn options(&self) -> GenerateOptions {
+        GenerateOptions {
+            coefficients: self.coefficients.clone(),
+            script: self.script.clone(),
+            blend: self.blend.clone(),
+            into: self.into.clone(),
+            modes: self.mode.clone(),
+            blender_version: self.blender_version,
+            blender: self.blender.options(false),
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// A preset (seed, blender-3, blender-4) or a coefficients file [default: the preset of
+    /// the Blender used].
+    #[arg(long, value_name = "PRESET|FILE")]
+    pub coefficients: Option<String>,
+
+    /// Distributions to check, comma-separated [default: all in the coefficients].
+    #[arg(long, short = 'd', value_delimiter = ',', value_parser = parse_distribution)]
+    pub distribution: Vec<Distribution>,
+
+    /// Roughness values of the sweep, comma-separated, each from 0 to 1 and given once.
+    #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness, allow_hyphen_values = true,
+          default_values_t = verify_defaults().roughness)]
+    pub roughness: Vec<Roughness>,
+
+    /// Cycles samples per pixel (32 keeps each sphere's standard error ≤ 0.2 %).
+    #[arg(long, default_value_t = verify_defaults().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
+
+    /// Pixels across each sphere's cell.
+    #[arg(long, default_value_t = verify_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    pub resolution: u32,
+
+    /// Allowed |mean − 100 %| of a corrected sphere, in percent.
+    #[arg(long, default_value_t = verify_defaults().judging.tolerance_percent, value_parser = parse_tolerance)]
+    pub tolerance: f64,
+
+    /// Cycles' random seed (another seed gives the same means with fresh noise).
+    #[arg(long, default_value_t = verify_defaults().render.seed)]
+    pub seed: u32,
+
+    /// Which correction to check: roughness (gain 100/f(r), judged by each sphere's mean),
+    /// view (gain 1/E(μ, r)) or multiscatter (Glossy + diffuse (1 − E)), the last two also
+    /// judged ring by ring.
+    #[arg(long, value_parser = one_of(MODES, Mode::key), default_value = verify_defaults().mode.key())]
+    pub mode: Mode,
+
+    /// In the view modes: allowed |mean − 100 %| of every view-cosine ring, in percent.
+    #[arg(long, default_value_t = verify_defaults().judging.ring_tolerance_percent, value_parser = parse_tolerance)]
+    pub ring_tolerance: f64,
+
+    /// Also write report.json, the rendered sweep.exr, contact-sheet.png and brightness.png here.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+
+    /// Print the JSON report instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl VerifyArgs {
+    pub fn options(&self) -> VerifyOptions {
+        VerifyOptions {
+            coefficients: self.coefficients.clone(),
+            distributions: self.distribution.clone(),
+            roughness: self.roughness.clone(),
+            render: RenderSettings {
+                cell: self.resolution,
+                samples: self.spp,
+                seed: self.seed,
+                ..RenderSettings::default()
+            },
+            mode: self.mode,
+            judging: Judging {
+                tolerance_percent: self.tolerance,
+                ring_tolerance_percent: self.ring_tolerance,
+            },
+            blender: self.blender.options(self.json),
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RefreshArgs {
+    /// Where to write the new coefficients file (atomically).
+    #[arg(long, value_name = "FILE.json", default_value_os_t = refresh_defaults().out)]
+    pub out: PathBuf,
+
+    /// Polynomial degree in r (6 keeps every distribution within 0.1 % of the measurement).
+    #[arg(long, default_value_t = refresh_defaults().degree as u64, value_parser = clap::value_parser!(u64).range(2..=8))]
+    pub degree: u64,
+
+    /// Cycles samples per pixel for the measurement.
+    #[arg(long, default_value_t = refresh_defaults().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
+
+    /// Pixels across each sphere's cell.
+    #[arg(long, default_value_t = refresh_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    pub resolution: u32,
+
+    /// Skip the verify run with the new coefficients.
+    #[arg(long)]
+    pub no_verify: bool,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl RefreshArgs {
+    pub fn options(&self) -> RefreshOptions {
+        let defaults = RefreshOptions::default();
+        RefreshOptions {
+            out: self.out.clone(),
+            degree: self.degree as usize,
+            render: RenderSettings {
+                cell: self.resolution,
+                samples: self.spp,
+                ..defaults.render
+            },
+            verify: !self.no_verify,
+            blender: self.blender.options(self.json),
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Roughness values of the sweep, comma-separated (the default is verify's sweep).
+    #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness,
+          default_values_t = BenchOptions::default().roughness)]
+    pub roughness: Vec<Roughness>,
+
+    /// Cycles samples per pixel.
+    #[arg(long, default_value_t = BenchOptions::default().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: u32,
+
+    #[command(flatten)]
+    pub blender: BlenderArgs,
+}
+
+impl BenchArgs {
+    pub fn options(&self) -> BenchOptions {
+        BenchOptions {
+            roughness: self.roughness.clone(),
+            render: RenderSettings {
+                samples: self.spp,
+                ..RenderSettings::default()
+            },
+            blender: self.blender.options(false),
+        }
+    }
+}
+
+/// `gloffuse lut`: write a split-sum or Kulla–Conty lookup table as EXR, DDS or KTX2.
+///
+/// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct LutArgs {
+    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G).
+    #[arg(long, value_parser = one_of(KINDS, Kind::key), default_value = Kind::SplitSum.key())]
+    pub kind: Kind,
+
+    /// kulla-conty and albedo: beckmann, ggx or ashikhmin-shirley [default: ggx].
+    #[arg(long, short = 'd', value_parser = parse_distribution)]
+    pub distribution: Option<Distribution>,
+
+    /// kulla-conty and albedo: the Blender whose masking the BSDF follows (3.x separable, 3.6+ height-correlated) [default: 4.5].
+    #[arg(long, value_parser = parse_version)]
+    pub blender_version: Option<BlenderVersion>,
+
+    /// Texels per side, 1 to 8192 [default: 512 for split-sum, 64 for kulla-conty and albedo].
+    #[arg(long, value_name = "N")]
+    pub size: Option<u32>,
+
+    /// Hammersley samples per texel, 1 to 1048576 [default: 2048 split-sum (max error 7e-4), 4096 kulla-conty; albedo takes none: it is quadrature].
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u32>,
+
+    /// split-sum only: visible-normals (accurate) or classic (the textbook UE4 estimator verbatim) [default: visible-normals].
+    #[arg(long, value_parser = one_of(SAMPLINGS, Sampling::key))]
+    pub sampling: Option<Sampling>,
+
+    /// Bits per channel: 16 (half float) or 32 (float).
+    #[arg(long, value_parser = one_of(BITS, Bits::key), default_value = Bits::Half.key())]
+    pub bits: Bits,
+
+    /// split-sum only: ue4 (Schlick-GGX, k = α/2) or height-correlated (Smith GGX) [default: ue4].
+    #[arg(long, value_parser = one_of(G_MODELS, GModel::key))]
+    pub g_model: Option<GModel>,
+
+    /// exr, dds or ktx2 (KTX 2.0) [default: from the --out extension: .exr, .dds, .ktx2/.ktx].
+    #[arg(long, value_parser = one_of(FORMATS, Format::key))]
+    pub format: Option<Format>,
+
+    /// The file to write (atomically: it appears complete or not at all).
+    #[arg(long, short = 'o', value_name = "FILE")]
+    pub out: PathBuf,
+
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl LutArgs {
+    pub fn options(&self) -> LutOptions {
+        LutOptions {
+            kind: self.kind,
+            distribution: self.distribution,
+            blender_version: self.blender_version,
+            size: self.size,
+            samples: self.samples,
+            sampling: self.sampling,
+            bits: self.bits,
+            g_model: self.g_model,
+            format: self.format,
+            out: self.out.clone(),
+        }
+    }
+}
+
+#[derive(Subcommand, Debug)]
+pub enum CoefficientsCommand {
+    /// Print a readable summary of a preset or coefficients file (no argument: list presets).
+    Show {
+        /// A preset name (seed, blender-3, blender-4) or a path to a coefficients file.
+        #[arg(value_name = "PRESET|FILE")]
+        source: Option<String>,
+        /// Print the validated file as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn defaults_come_from_the_library() {
+        let cli = Cli::try_parse_from(["gloffuse", "verify"]).unwrap();
+        let Command::Verify(v) = cli.command else {
+            panic!("verify parses as verify")
+        };
+        assert_eq!(
+            v.options(),
+            VerifyOptions {
+                blender: BlenderOptions {
+                    installer_output: InstallerOutput::Stderr,
+                    ..BlenderOptions::default()
+                },
+                ..VerifyOptions::default()
+            }
+        );
+        let cli = Cli::try_parse_from(["gloffuse", "refresh"]).unwrap();
+        let Command::Refresh(r) = cli.command else {
+            panic!("refresh parses as refresh")
+        };
+        assert_eq!(
+            r.options(),
+            RefreshOptions {
+                blender: BlenderOptions {
+                    installer_output: InstallerOutput::Stderr,
+                    ..BlenderOptions::default()
+                },
+                ..RefreshOptions::default()
+            }
+        );
+    }
+
+    #[test]
+    fn lut_flags_parse() {
+        let cli = Cli::try_parse_from([
+            "gloffuse",
+            "lut",
+            "--kind",
+            "kulla-conty",
+            "--distribution",
+            "ASHIKHMIN_SHIRLEY",
+            "--blender-version",
+            "3.4.1",
+            "--size",
+            "32",
+            "--samples",
+            "100",
+            "--bits",
+            "32",
+            "--format",
+            "ktx",
+            "--out",
+            "x.ktx2",
+        ])
+        .unwrap();
+        let Command::Lut(a) = cli.command else {
+            panic!("lut parses as lut")
+        };
+        assert_eq!(a.kind, Kind::KullaConty);
+        assert_eq!(a.distribution, Some(Distribution::AshikhminShirley));
+        assert_eq!(
+            (a.size, a.samples, a.bits),
+            (Some(32), Some(100), Bits::Float)
+        );
+        assert_eq!(a.format, Some(Format::Ktx));
+        let cli = Cli::try_parse_from([
+            "gloffuse",
+            "lut",
+            "--g-model",
+            "height-correlated",
+            "--bits",
+            "16",
+            "--format",
+            "dds",
+            "-o",
+            "y",
+        ])
+        .unwrap();
+        let Command::Lut(a) = cli.command else {
+            panic!("lut parses as lut")
+        };
+        assert_eq!(a.kind, Kind::SplitSum);
+        assert_eq!(a.g_model, Some(GModel::HeightCorrelated));
+        assert_eq!(a.format, Some(Format::Dds));
+        assert!(Cli::try_parse_from(["gloffuse", "lut", "--bits", "8", "--out", "z.exr"]).is_err());
+        assert!(
+            Cli::try_parse_from(["gloffuse", "lut", "--kind", "split-sum"]).is_err(),
+            "--out is required"
+        );
+    }
+
+    /// Every flag of every command has real help: at least four words.
+    #[test]
+    fn every_flag_is_documented() {
+        let cli = Cli::command();
+        let mut checked = 0;
+        for command in cli.get_subcommands() {
+            let nested: Vec<_> = command.get_subcommands().collect();
+            for c in std::iter::once(command).chain(nested) {
+                for arg in c.get_arguments() {
+                    let Some(long) = arg.get_long() else { continue };
+                    let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+                    assert!(
+                        help.split_whitespace().count() >= 4,
+                        "{} --{long} has no real help: {help:?}",
+                        c.get_name()
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 40, "only {checked} flags found");
+    }
+}

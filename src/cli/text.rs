@@ -1,0 +1,241 @@
+//! What the commands print as text: every rendering for a person, in one file. (The verify
+//! table is a renderer of the verdict and lives with the others in `gloffuse::report`.)
+
+use std::fmt::Write as _;
+
+use gloffuse::fit::coefficients::Entry;
+use gloffuse::fit::{ColorSpace, Curve, Target, Variable, Weighting};
+use gloffuse::generate::Generated;
+use gloffuse::lut::LutSummary;
+use gloffuse::refresh::Refreshed;
+
+/// The summary `generate` prints.
+pub fn generated(out: &Generated) -> String {
+    let mut s = String::new();
+    if let Some(p) = &out.script {
+        let _ = writeln!(s, "script: {}", p.display());
+    }
+    if let Some(p) = &out.blend {
+        let _ = writeln!(
+            s,
+            "blend:  {} (Blender {})",
+            p.display(),
+            out.blender.as_deref().unwrap_or("?")
+        );
+    }
+    if let Some(p) = &out.backup {
+        let _ = writeln!(s, "backup: {}", p.display());
+    }
+    let _ = writeln!(s, "coefficients: {}", out.coefficients);
+    let _ = writeln!(s, "groups: {}", out.groups.join(", "));
+    s
+}
+
+/// The measured curve beside the prediction, the warnings, then the verify table.
+pub fn refresh(r: &Refreshed) -> String {
+    let mut s = format!(
+        "Blender {}: measured furnace sphere means vs the integrator\n",
+        r.blender_version
+    );
+    let _ = writeln!(
+        s,
+        "{:<18} {:>5} {:>9} {:>7} {:>10} {:>7}",
+        "distribution", "r", "measured", "±SE", "predicted", "diff"
+    );
+    for m in &r.measurements {
+        let _ = writeln!(
+            s,
+            "{:<18} {:>5} {:>8.2}% {:>6.2}% {:>9.2}% {:>+6.2}%",
+            m.distribution.label(),
+            m.roughness,
+            100.0 * m.measured,
+            100.0 * m.standard_error,
+            100.0 * m.predicted,
+            100.0 * (m.measured / m.predicted - 1.0)
+        );
+    }
+    for w in &r.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    let _ = writeln!(s, "wrote {}", r.out);
+    if let Some(v) = &r.verify {
+        let _ = write!(s, "\n{}", gloffuse::report::table::render(v));
+    }
+    s
+}
+
+/// The human-readable summary `gloffuse lut` prints.
+pub fn lut(s: &LutSummary) -> String {
+    let mut out = format!(
+        "wrote {} ({} bytes): {} {}×{} {}, {} {}-bit\n",
+        s.path.display(),
+        s.bytes,
+        s.kind.key(),
+        s.width,
+        s.height,
+        s.format.key(),
+        s.pixel_format,
+        s.bits.count(),
+    );
+    let mut how = vec![match s.samples {
+        Some(n) => format!("{n} samples per texel"),
+        None => "deterministic quadrature".to_string(),
+    }];
+    if let Some(g) = s.g_model {
+        how.push(format!("{} masking", g.key()));
+    }
+    if let Some(m) = s.sampling {
+        how.push(format!("{} sampling", m.key()));
+    }
+    if let Some(d) = s.distribution {
+        how.push(format!("{d}"));
+    }
+    if let Some(v) = &s.blender_version {
+        how.push(format!("Blender {v}"));
+    }
+    out += &format!("  {}\n", how.join(", "));
+    for c in &s.channels {
+        out += &format!("  {c}\n");
+    }
+    out += &format!(
+        "  uv = (roughness, N·V); texel (x, y) at ((x + ½)/{}, (y + ½)/{}), first row first\n",
+        s.width, s.height
+    );
+    out += &format!(
+        "  computed in {:.2} s ({:.2} s in all)\n",
+        s.compute_seconds, s.seconds
+    );
+    out
+}
+
+/// `f(r) = −34 r³ + 5 r² + 100` style text for a polynomial curve.
+pub fn formula(curve: &Curve) -> String {
+    let var = match curve.variable {
+        Variable::Roughness => "r",
+        Variable::Alpha => "α",
+    };
+    let poly = |c: &[f64]| {
+        let mut terms = Vec::new();
+        for (k, &v) in c.iter().enumerate().rev() {
+            if v == 0.0 && k != 0 {
+                continue;
+            }
+            let t = match k {
+                0 => fmt_num(v.abs()),
+                1 => format!("{} {var}", fmt_num(v.abs())),
+                _ => format!("{} {var}^{k}", fmt_num(v.abs())),
+            };
+            let sign = if v < 0.0 { "−" } else { "+" };
+            terms.push((sign, t));
+        }
+        let mut s = String::new();
+        for (i, (sign, t)) in terms.iter().enumerate() {
+            if i == 0 {
+                if *sign == "−" {
+                    s.push('−');
+                }
+            } else {
+                let _ = write!(s, " {sign} ");
+            }
+            s.push_str(t);
+        }
+        s
+    };
+    if curve.denominator == [1.0] {
+        poly(&curve.numerator)
+    } else {
+        format!(
+            "({}) / ({})",
+            poly(&curve.numerator),
+            poly(&curve.denominator)
+        )
+    }
+}
+
+fn fmt_num(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+/// One distribution's curve, its fit and where it came from, as `fit` and
+/// `coefficients show` print it.
+pub fn entry(label: &str, e: &Entry) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "{label}: f(r) = {}", formula(&e.curve));
+    if e.curve.variable == Variable::Roughness && e.curve.denominator == [1.0] {
+        let n = &e.curve.numerator;
+        let c = |k: usize| n.get(k).copied().unwrap_or(0.0);
+        let mut line = format!(
+            "  a = {}, b = {}, c = {}, d = {}",
+            fmt_num_signed(c(3)),
+            fmt_num_signed(c(2)),
+            fmt_num_signed(c(1)),
+            fmt_num_signed(c(0))
+        );
+        for k in 4..n.len() {
+            let _ = write!(line, ", r^{k}: {}", fmt_num_signed(c(k)));
+        }
+        let _ = writeln!(s, "{line}");
+    }
+    let _ = writeln!(
+        s,
+        "  degree {}, target {}, {} colour, {} masking, {} weighting",
+        e.degree,
+        match e.target {
+            Target::Mean => "mean (E_avg)",
+            Target::Center => "centre (E(1, r))",
+        },
+        match e.color_space {
+            ColorSpace::Linear => "linear",
+            ColorSpace::Display => "display-referred (sRGB)",
+        },
+        e.masking,
+        match e.weighting {
+            Weighting::Absolute => "absolute",
+            Weighting::Relative => "relative",
+        }
+    );
+    let r = &e.residuals;
+    let _ = writeln!(
+        s,
+        "  residuals: max {:.4} points (rms {:.4}); gain error max {:.4} % (rms {:.4} %)",
+        r.max_points,
+        r.rms_points,
+        100.0 * r.max_gain_error,
+        100.0 * r.rms_gain_error
+    );
+    let p = &e.provenance;
+    let mut prov = format!("  from {} ({} points", p.source.key(), p.points);
+    if let Some(v) = &p.blender_version {
+        let _ = write!(prov, ", Blender {v}");
+    }
+    if let Some(v) = &p.samples {
+        let _ = write!(prov, ", {v}");
+    }
+    if let Some(v) = p.resolution {
+        let _ = write!(prov, ", {v} px");
+    }
+    if let Some(v) = &p.date {
+        let _ = write!(prov, ", {v}");
+    }
+    prov.push(')');
+    if let Some(n) = &p.note {
+        let _ = write!(prov, ": {n}");
+    }
+    let _ = writeln!(s, "{prov}");
+    let gains: Vec<String> = [0.25, 0.5, 0.75, 1.0]
+        .iter()
+        .map(|&r| format!("r={r}: {:.4}", e.curve.gain(r)))
+        .collect();
+    let _ = writeln!(s, "  gain 100/f: {}", gains.join(", "));
+    s
+}
+
+fn fmt_num_signed(v: f64) -> String {
+    if v < 0.0 {
+        format!("-{}", fmt_num(-v))
+    } else {
+        fmt_num(v)
+    }
+}

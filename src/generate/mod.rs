@@ -1,0 +1,206 @@
+//! ③ Generate: the node groups as a Python script, a new .blend, or into an existing .blend.
+//! `params` is the parameter document, `script` assembles the Python, `blend` checks what
+//! Blender wrote.
+
+pub mod blend;
+pub mod params;
+pub mod script;
+
+pub use params::{GenerateParams, GroupSpec, Mode, correction_group_name, shader_group_name};
+pub use script::{Job, assemble};
+
+use serde::Serialize;
+use std::ffi::OsString;
+use std::path::PathBuf;
+
+use crate::Error;
+use crate::blender::{BlenderOptions, Run, command_line, run_script};
+use crate::fit::Coefficients;
+use crate::measure::BlenderVersion;
+use crate::output::{check_destination, write_atomic};
+use crate::progress::Progress;
+use blend::{incomplete_blend, starts_like_blend, temp_beside};
+
+/// What `generate` writes, and from what.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenerateOptions {
+    /// A preset or coefficients file (else the preset of the Blender used).
+    pub coefficients: Option<String>,
+    /// Write the Python script here (needs no Blender).
+    pub script: Option<PathBuf>,
+    /// Write a new .blend library holding the groups.
+    pub blend: Option<PathBuf>,
+    /// Add or replace the groups in this existing .blend, in place (keeping a .blend1).
+    pub into: Option<PathBuf>,
+    /// Which groups to build besides the roughness-only pair.
+    pub modes: Vec<Mode>,
+    /// With only `script`: the Blender version whose preset and masking to use.
+    pub blender_version: BlenderVersion,
+    pub blender: BlenderOptions,
+}
+
+impl Default for GenerateOptions {
+    fn default() -> Self {
+        GenerateOptions {
+            coefficients: None,
+            script: None,
+            blend: None,
+            into: None,
+            modes: vec![Mode::Roughness],
+            blender_version: BlenderVersion::DEFAULT,
+            blender: BlenderOptions::default(),
+        }
+    }
+}
+
+/// What `generate` wrote.
+#[derive(Debug, Serialize)]
+pub struct Generated {
+    pub blender: Option<String>,
+    pub coefficients: String,
+    pub script: Option<PathBuf>,
+    pub blend: Option<PathBuf>,
+    pub backup: Option<PathBuf>,
+    pub groups: Vec<String>,
+    pub log: Option<PathBuf>,
+}
+
+/// Writes what `g` asks for; nothing is written if anything fails.
+pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
+    if g.script.is_none() && g.blend.is_none() && g.into.is_none() {
+        return Err(Error::input(
+            "arguments",
+            "(no output)",
+            "--script OUT.py, --blend OUT.blend or --into EXISTING.blend",
+        ));
+    }
+    if let Some(into) = &g.into {
+        let expected = if !into.is_file() {
+            Some("an existing .blend file")
+        } else if !starts_like_blend(into) {
+            Some("an existing .blend file (this file does not start with a .blend header)")
+        } else {
+            None
+        };
+        if let Some(expected) = expected {
+            return Err(Error::input(
+                "--into",
+                &into.display().to_string(),
+                expected,
+            ));
+        }
+    }
+    // Outputs are checked before Blender is looked for: bad input fails fast.
+    for out in [&g.blend, &g.script].into_iter().flatten() {
+        check_destination(out)?;
+    }
+    let needs_blender = g.blend.is_some() || g.into.is_some();
+    // Coefficients are checked before Blender is looked for: bad input fails fast.
+    let explicit = g
+        .coefficients
+        .as_deref()
+        .map(|name| Coefficients::load_or_preset(Some(name), g.blender_version))
+        .transpose()?;
+    let blender = if needs_blender {
+        Some(g.blender.find(progress)?)
+    } else {
+        None
+    };
+    let version: BlenderVersion = blender
+        .as_ref()
+        .map(|b| b.version)
+        .unwrap_or(g.blender_version);
+    let (coefficients, source) = match explicit {
+        Some(named) => named,
+        None => Coefficients::load_or_preset(None, version)?,
+    };
+    let mut params = GenerateParams::new(&coefficients, &source);
+    if g.modes.iter().any(|m| *m != Mode::Roughness) {
+        params = params.with_view(version.masking());
+    }
+    let script = assemble(&params, Job::Generate);
+    let mut out = Generated {
+        blender: blender.as_ref().map(|b| b.version_string.clone()),
+        coefficients: source,
+        script: None,
+        blend: None,
+        backup: None,
+        groups: params
+            .groups
+            .iter()
+            .flat_map(|s| {
+                let mut names = vec![s.correction_group.clone(), s.shader_group.clone()];
+                if let Some(v) = &s.view {
+                    names.extend([
+                        v.correction_group.clone(),
+                        v.shader_group.clone(),
+                        v.multiscatter_group.clone(),
+                    ]);
+                }
+                names
+            })
+            .collect(),
+        log: None,
+    };
+    let Some(blender) = blender else {
+        if let Some(path) = &g.script {
+            write_atomic(path, script.as_bytes())?;
+            out.script = Some(path.clone());
+        }
+        return Ok(out);
+    };
+
+    let run_dir = crate::blender::runs::new_run_dir("generate")?;
+    let script_path = run_dir.join("gloffuse-generate.py");
+    write_atomic(&script_path, script.as_bytes())?;
+    let dest = g
+        .blend
+        .clone()
+        .or_else(|| g.into.clone())
+        .expect("needs_blender");
+    let tmp = temp_beside(&dest, ".blend")?;
+    let mut args: Vec<OsString> = Vec::new();
+    if let Some(into) = &g.into {
+        args.extend([OsString::from("--open"), into.clone().into_os_string()]);
+    }
+    args.extend([OsString::from("--save"), tmp.to_path_buf().into_os_string()]);
+    let log = run_dir.join("blender.log");
+    let run = Run {
+        blender: &blender,
+        script: &script_path,
+        args,
+        timeout: g.blender.timeout,
+        log: log.clone(),
+    };
+    run_script(&run)?;
+    if let Some(why) = incomplete_blend(&tmp) {
+        return Err(Error::Blender {
+            message: format!("Blender reported success but {why}"),
+            log: Some(log),
+            command: Some(command_line(&run)),
+        });
+    }
+    // Only now, with the .blend made, the script: a failed run leaves no output at all.
+    if let Some(path) = &g.script {
+        write_atomic(path, script.as_bytes())?;
+        out.script = Some(path.clone());
+    }
+    if g.into.is_some() {
+        // Blender's own convention: the previous version stays beside the file as .blend1.
+        let mut backup = dest.clone().into_os_string();
+        backup.push("1");
+        let backup = PathBuf::from(backup);
+        std::fs::copy(&dest, &backup).map_err(|e| Error::Write {
+            path: backup.clone(),
+            message: e.to_string(),
+        })?;
+        out.backup = Some(backup);
+    }
+    tmp.persist(&dest).map_err(|e| Error::Write {
+        path: dest.clone(),
+        message: e.error.to_string(),
+    })?;
+    out.blend = Some(dest);
+    out.log = Some(log);
+    Ok(out)
+}

@@ -1,0 +1,14 @@
+//! ① Measure: the physics. The microfacet distributions (`microfacet`), the Glossy BSDF as
+//! Cycles evaluates it (`glossy`), its albedo by quadrature (`albedo`), the masking family of
+//! each Blender version (`version`), and the classic BRDF set (`brdf`).
+
+pub mod albedo;
+pub mod brdf;
+pub mod glossy;
+pub mod microfacet;
+pub mod version;
+
+pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
+pub use glossy::Glossy;
+pub use microfacet::{Distribution, Masking, Microfacet, Polar, Roughness};
+pub use version::BlenderVersion;

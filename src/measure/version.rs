@@ -1,0 +1,96 @@
+//! Blender versions as plain data, and what they imply for the physics: the masking family
+//! of each version's Cycles.
+
+use super::microfacet::Masking;
+use crate::Error;
+
+/// A Blender release, `major.minor` (a patch number is accepted and ignored).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct BlenderVersion {
+    pub major: u32,
+    pub minor: u32,
+}
+
+impl BlenderVersion {
+    /// The oldest Blender whose Glossy BSDF gloffuse models (the 3.x series onwards).
+    pub const OLDEST: BlenderVersion = BlenderVersion { major: 3, minor: 0 };
+
+    /// The version modelled when none is named: 4.5 LTS, the series gloffuse installs.
+    pub const DEFAULT: BlenderVersion = BlenderVersion { major: 4, minor: 5 };
+
+    /// The masking–shadowing form Cycles uses in this version.
+    ///
+    /// Cycles' microfacet refactor switched from the separable `G1(ωi) G1(ωo)` to the
+    /// height-correlated `1/(1 + Λi + Λo)`; the 3.6-era source already has the
+    /// height-correlated form, the 3.4 source the separable one (3.5 is unconfirmed and
+    /// treated as separable). See `docs/PHYSICS.md` §3.
+    pub fn masking(self) -> Masking {
+        if self >= (BlenderVersion { major: 3, minor: 6 }) {
+            Masking::HeightCorrelated
+        } else {
+            Masking::Separable
+        }
+    }
+}
+
+impl std::fmt::Display for BlenderVersion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}.{}", self.major, self.minor)
+    }
+}
+
+impl std::str::FromStr for BlenderVersion {
+    type Err = Error;
+
+    /// Accepts `4.5`, `4.5.4`, `3.4.1`, with an optional leading `v` or `Blender `.
+    fn from_str(s: &str) -> Result<Self, Error> {
+        let bad = || {
+            Error::input(
+                "Blender version",
+                s,
+                "a version like 3.4, 4.5 or 5.0 (3.0 or later)",
+            )
+        };
+        let t = s.trim();
+        let t = t.strip_prefix("Blender ").unwrap_or(t);
+        let t = t.strip_prefix('v').unwrap_or(t);
+        let mut parts = t.split('.');
+        let major: u32 = parts.next().ok_or_else(bad)?.parse().map_err(|_| bad())?;
+        let minor: u32 = parts.next().ok_or_else(bad)?.parse().map_err(|_| bad())?;
+        if let Some(patch) = parts.next() {
+            patch.parse::<u32>().map_err(|_| bad())?;
+        }
+        if parts.next().is_some() {
+            return Err(bad());
+        }
+        let v = BlenderVersion { major, minor };
+        if v < Self::OLDEST {
+            return Err(Error::input(
+                "Blender version",
+                s,
+                "Blender 3.0 or later (older Glossy BSDFs are not modelled)",
+            ));
+        }
+        Ok(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_picks_masking() {
+        let v: BlenderVersion = "3.4.1".parse().unwrap();
+        assert_eq!(v, BlenderVersion { major: 3, minor: 4 });
+        assert_eq!(v.masking(), Masking::Separable);
+        assert_eq!(
+            "4.5".parse::<BlenderVersion>().unwrap().masking(),
+            Masking::HeightCorrelated
+        );
+        assert!("2.79".parse::<BlenderVersion>().is_err());
+        assert!("four".parse::<BlenderVersion>().is_err());
+        assert!("4".parse::<BlenderVersion>().is_err());
+        assert!("4.5.1.2".parse::<BlenderVersion>().is_err());
+    }
+}

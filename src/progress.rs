@@ -1,0 +1,23 @@
+//! How long-running library calls say what they are doing: they call a [`Progress`], and the
+//! caller decides what to show (the CLI draws on stderr; tests and scripts pass [`Quiet`]).
+//! The library itself never prints.
+
+/// Receives notices and the progress of one task at a time. Every method has a do-nothing
+/// default; `step` may be called from worker threads.
+pub trait Progress: Sync {
+    /// A one-line notice for the user (which Blender is used, that bpy is being installed).
+    fn notice(&self, _message: &str) {}
+    /// A task of `steps` steps starts; `message` says what it does.
+    fn begin(&self, _message: &str, _steps: u64) {}
+    /// `done` steps of the current task are finished.
+    fn set(&self, _done: u64) {}
+    /// One more step of the current task is finished.
+    fn step(&self) {}
+    /// The current task is over (finished or failed).
+    fn end(&self) {}
+}
+
+/// A [`Progress`] that shows nothing.
+pub struct Quiet;
+
+impl Progress for Quiet {}

@@ -1,0 +1,530 @@
+//! The picture outputs of `verify --report`: a labelled contact sheet of the rendered
+//! furnace grid and a plot of brightness against roughness, both PNG.
+//!
+//! Text is drawn with DejaVu Sans, embedded in the binary (`assets/fonts/`, Bitstream Vera
+//! licence), so no system fonts are needed.
+
+use std::fmt::Display;
+use std::path::Path;
+use std::sync::OnceLock;
+
+use image::{ExtendedColorType, ImageEncoder, codecs::png::PngEncoder};
+use plotters::backend::RGBPixel;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::Error;
+use crate::measure::Distribution;
+use crate::output::write_atomic;
+use crate::verify::VerifyReport;
+use crate::verify::image::Rgba;
+use crate::verify::plan::{Plan, Role};
+
+/// Linear value of the background the spheres are composited over: 18 % grey, the
+/// photographic middle grey, so a sphere brighter or darker than 100 % stands out either way.
+pub const BACKGROUND: f32 = 0.18;
+
+/// Size of the brightness plot in pixels.
+pub const PLOT_SIZE: (u32, u32) = (900, 600);
+
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FAMILY: &str = "sans-serif";
+
+/// Label column and header of the contact sheet (sRGB).
+const LABEL_BACKGROUND: RGBColor = RGBColor(40, 40, 40);
+const LABEL_TEXT: RGBColor = RGBColor(235, 235, 235);
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value clamped to [0, 1], as an
+/// 8-bit code value. NaN gives 0.
+///
+/// ```
+/// use gloffuse::report::png::srgb8;
+/// assert_eq!(srgb8(0.18), 118);
+/// assert_eq!(srgb8(0.5), 188);
+/// assert_eq!(srgb8(2.0), 255);
+/// assert_eq!(srgb8(f32::NAN), 0);
+/// ```
+pub fn srgb8(linear: f32) -> u8 {
+    if linear.is_nan() {
+        return 0;
+    }
+    let v = linear.clamp(0.0, 1.0);
+    let encoded = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (encoded * 255.0).round() as u8
+}
+
+/// Row and column labels of a plan's grid, for [`contact_sheet`]: `GGX uncorrected`,
+/// `GGX corrected`, …, `Multiscatter GGX`; the roughness values of the first row.
+pub fn sheet_labels(plan: &Plan) -> (Vec<String>, Vec<String>) {
+    let columns = plan.columns.max(1);
+    let rows = plan
+        .cells
+        .chunks(columns)
+        .map(|row| match row[0].role {
+            Role::Uncorrected(d) => format!("{} uncorrected", d.label()),
+            Role::Corrected(d) => format!("{} corrected", d.label()),
+            Role::Reference => "Multiscatter GGX".to_string(),
+        })
+        .collect();
+    let cols = plan
+        .cells
+        .iter()
+        .take(columns)
+        .map(|c| format_roughness(c.roughness))
+        .collect();
+    (rows, cols)
+}
+
+/// `0.5`, `0.25`, `0.125`: at most three decimals, no trailing zeros.
+fn format_roughness(r: f64) -> String {
+    let s = format!("{r:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s.is_empty() || s == "-" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
+/// Contact sheet: the rendered furnace grid (scene-linear RGBA premultiplied by alpha, row 0
+/// at the top; rows as in [`Plan::verify`], columns are roughness values) composited over
+/// [`BACKGROUND`] grey, display-encoded with the sRGB transfer function (clamped to [0, 1]),
+/// with a label column on the left and a header row of `column_labels`, written as PNG
+/// atomically. The grid's pixels are exact: one image pixel per sheet pixel, no filtering.
+pub fn contact_sheet(
+    image: &Rgba,
+    cell: usize,
+    row_labels: &[String],
+    column_labels: &[String],
+    out: &Path,
+) -> Result<(), Error> {
+    let geometry = |value: String, expected: &str| Error::input("contact sheet", &value, expected);
+    if cell == 0 || image.width == 0 || image.height == 0 {
+        return Err(geometry(
+            format!("{}×{} image, cell {cell}", image.width, image.height),
+            "a non-empty image and a cell of at least 1 pixel",
+        ));
+    }
+    if image.pixels.len() != image.width * image.height {
+        return Err(geometry(
+            format!(
+                "{} pixels for {}×{}",
+                image.pixels.len(),
+                image.width,
+                image.height
+            ),
+            "width × height pixels",
+        ));
+    }
+    let (rows, columns) = (image.height.div_ceil(cell), image.width.div_ceil(cell));
+    if row_labels.len() != rows || column_labels.len() != columns {
+        return Err(geometry(
+            format!(
+                "{} row and {} column labels",
+                row_labels.len(),
+                column_labels.len()
+            ),
+            &format!(
+                "one label per row and column of the {rows}×{columns} grid of {cell}-pixel cells"
+            ),
+        ));
+    }
+    register_font().map_err(|m| write_error(out, m))?;
+
+    // Labels sized to the cell, within readable limits; the header shrinks further if the
+    // roughness values would not fit over their columns.
+    let label_px = (cell as f64 * 0.25).clamp(12.0, 18.0);
+    let pad = (label_px * 0.6).round() as u32;
+    let width_of = |text: &str, px: f64| -> Result<u32, Error> {
+        text_size(text, px)
+            .map(|(w, _)| w)
+            .map_err(|e| write_error(out, e))
+    };
+    let corner = "roughness";
+    let mut label_w = width_of(corner, label_px)?;
+    for l in row_labels {
+        label_w = label_w.max(width_of(l, label_px)?);
+    }
+    let mut widest_column = 1;
+    for l in column_labels {
+        widest_column = widest_column.max(width_of(l, label_px)?);
+    }
+    let header_px =
+        (label_px * (cell as f64 - 4.0).max(1.0) / widest_column as f64).clamp(8.0, label_px);
+    let left = (label_w + 2 * pad) as usize;
+    let top = (label_px * 1.5).round() as usize + pad as usize;
+    let (w, h) = (left + image.width, top + image.height);
+
+    let mut rgb = vec![0u8; w * h * 3];
+    for (i, px) in rgb.chunks_exact_mut(3).enumerate() {
+        px.copy_from_slice(&[LABEL_BACKGROUND.0, LABEL_BACKGROUND.1, LABEL_BACKGROUND.2]);
+        let (x, y) = (i % w, i / w);
+        if x >= left && y >= top {
+            let [r, g, b, a] = image.pixels[(y - top) * image.width + (x - left)];
+            let under = (1.0 - a.clamp(0.0, 1.0)) * BACKGROUND;
+            px.copy_from_slice(&[srgb8(r + under), srgb8(g + under), srgb8(b + under)]);
+        }
+    }
+
+    {
+        let root = backend(&mut rgb, (w as u32, h as u32), out)?.into_drawing_area();
+        let draw = |text: &str, px: f64, anchor: Pos, at: (i32, i32)| {
+            let style = TextStyle::from((FAMILY, px).into_font())
+                .color(&LABEL_TEXT)
+                .pos(anchor);
+            root.draw_text(text, &style, at)
+                .map_err(|e| write_error(out, format!("cannot draw the label '{text}': {e}")))
+        };
+        let right = Pos::new(HPos::Right, VPos::Center);
+        let centre = Pos::new(HPos::Center, VPos::Center);
+        let header_y = (top / 2) as i32;
+        draw(
+            corner,
+            label_px,
+            right,
+            (left as i32 - pad as i32, header_y),
+        )?;
+        for (j, l) in column_labels.iter().enumerate() {
+            let x = left + j * cell + cell / 2;
+            draw(l, header_px, centre, (x as i32, header_y))?;
+        }
+        for (i, l) in row_labels.iter().enumerate() {
+            let y = top + i * cell + cell / 2;
+            draw(l, label_px, right, (left as i32 - pad as i32, y as i32))?;
+        }
+        root.present().map_err(|e| write_error(out, e))?;
+    }
+    write_png(&rgb, (w as u32, h as u32), out)
+}
+
+/// Colours of one distribution's series in the plot.
+fn colour(d: Distribution) -> RGBColor {
+    match d {
+        Distribution::Beckmann => RGBColor(31, 119, 180),
+        Distribution::Ggx => RGBColor(214, 39, 40),
+        Distribution::AshikhminShirley => RGBColor(44, 160, 44),
+    }
+}
+
+const REFERENCE_COLOUR: RGBColor = RGBColor(90, 90, 90);
+
+/// (roughness, brightness %) points of one series.
+type Points = Vec<(f64, f64)>;
+
+/// `(x, 100·y)` for the finite points, sorted by x.
+fn percent_points(points: impl Iterator<Item = (f64, f64)>) -> Points {
+    let mut v: Points = points
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(x, y)| (x, 100.0 * y))
+        .collect();
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    v
+}
+
+/// Plot of brightness (%) against roughness: per distribution the uncorrected and corrected
+/// sphere means (hollow and filled circles) with the integrator's predictions for each
+/// (dashed and solid lines), Blender's Multiscatter GGX reference (triangles), 100 % with the
+/// tolerance band; legend, axis labels, and a title naming the Blender version and the
+/// coefficients. [`PLOT_SIZE`] pixels, written as PNG atomically. NaN values are left out.
+pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
+    register_font().map_err(|m| write_error(out, m))?;
+    let fail = |e: &dyn Display| write_error(out, format!("cannot draw the plot: {e}"));
+
+    let mut distributions: Vec<Distribution> = Vec::new();
+    for row in &report.rows {
+        if !distributions.contains(&row.distribution) {
+            distributions.push(row.distribution);
+        }
+    }
+    let series: Vec<(Distribution, [Points; 4])> = distributions
+        .iter()
+        .map(|&d| {
+            let rows = || report.rows.iter().filter(move |r| r.distribution == d);
+            let pts = |f: fn(&crate::verify::Row) -> f64| {
+                percent_points(rows().map(|r| (r.roughness, f(r))))
+            };
+            (
+                d,
+                [
+                    pts(|r| r.uncorrected.mean),
+                    pts(|r| r.predicted_uncorrected),
+                    pts(|r| r.corrected.mean),
+                    pts(|r| r.predicted_corrected),
+                ],
+            )
+        })
+        .collect();
+    let reference = percent_points(report.reference.iter().map(|s| (s.roughness, s.stats.mean)));
+
+    let tolerance = if report.tolerance_percent.is_finite() {
+        report.tolerance_percent.abs()
+    } else {
+        0.0
+    };
+    let all = || {
+        series
+            .iter()
+            .flat_map(|(_, s)| s.iter().flatten())
+            .chain(reference.iter())
+    };
+    let (mut y_lo, mut y_hi) = (100.0 - tolerance, 100.0 + tolerance);
+    let (mut x_lo, mut x_hi) = (0.0f64, 1.0f64);
+    for &(x, y) in all() {
+        (x_lo, x_hi) = (x_lo.min(x), x_hi.max(x));
+        (y_lo, y_hi) = (y_lo.min(y), y_hi.max(y));
+    }
+    // Whole multiples of 5 % with some air, at least 20 % tall.
+    let y_lo = ((y_lo - 2.0) / 5.0).floor() * 5.0;
+    let y_hi = (((y_hi + 2.0) / 5.0).ceil() * 5.0).max(y_lo + 20.0);
+    let x_pad = 0.02 * (x_hi - x_lo);
+    let (x_lo, x_hi) = (x_lo - x_pad, x_hi + x_pad);
+
+    let title = format!(
+        "Furnace brightness · Blender {} · coefficients {}",
+        report.render.blender_version,
+        shorten(&report.coefficients, 40)
+    );
+    let (w, h) = PLOT_SIZE;
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = backend(&mut rgb, (w, h), out)?.into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let below_title = root.titled(&title, (FAMILY, 20)).map_err(|e| fail(&e))?;
+        let (plot_area, legend_area) = below_title.split_horizontally(w as i32 - LEGEND_WIDTH);
+        let mut chart = ChartBuilder::on(&plot_area)
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("roughness")
+            .y_desc("brightness (%)")
+            .axis_desc_style((FAMILY, 15))
+            .label_style((FAMILY, 13))
+            .x_labels(11)
+            .y_labels(12)
+            .x_label_formatter(&|x| format!("{x:.1}"))
+            .y_label_formatter(&|y| format!("{y:.0}"))
+            .light_line_style(RGBColor(242, 242, 242))
+            .bold_line_style(RGBColor(215, 215, 215))
+            .draw()
+            .map_err(|e| fail(&e))?;
+
+        let mut legend = Vec::new();
+        if tolerance > 0.0 {
+            chart
+                .draw_series([Rectangle::new(
+                    [(x_lo, 100.0 - tolerance), (x_hi, 100.0 + tolerance)],
+                    PASS_BAND.mix(0.12).filled(),
+                )])
+                .map_err(|e| fail(&e))?;
+        }
+        for (d, [uncorrected, predicted_u, corrected, predicted_c]) in &series {
+            let c = colour(*d);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    predicted_u.iter().copied(),
+                    6,
+                    4,
+                    c.mix(0.6).stroke_width(2),
+                ))
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(LineSeries::new(
+                    predicted_c.iter().copied(),
+                    c.stroke_width(2),
+                ))
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(
+                    uncorrected
+                        .iter()
+                        .map(|&p| Circle::new(p, 4, c.stroke_width(2))),
+                )
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(corrected.iter().map(|&p| Circle::new(p, 4, c.filled())))
+                .map_err(|e| fail(&e))?;
+            legend.push(Legend::Heading(d.label().to_string(), c));
+            legend.push(Legend::Entry(
+                Key::Hollow(c),
+                "uncorrected, rendered".into(),
+            ));
+            legend.push(Legend::Entry(
+                Key::Dashed(c.mix(0.6), 2),
+                "uncorrected, predicted".into(),
+            ));
+            legend.push(Legend::Entry(Key::Filled(c), "corrected, rendered".into()));
+            legend.push(Legend::Entry(
+                Key::Solid(c.into()),
+                "corrected, predicted".into(),
+            ));
+        }
+        if !reference.is_empty() {
+            chart
+                .draw_series(LineSeries::new(
+                    reference.iter().copied(),
+                    REFERENCE_COLOUR.stroke_width(1),
+                ))
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(
+                    reference
+                        .iter()
+                        .map(|&p| TriangleMarker::new(p, 5, REFERENCE_COLOUR.filled())),
+                )
+                .map_err(|e| fail(&e))?;
+            legend.push(Legend::Heading("Reference".into(), REFERENCE_COLOUR));
+            legend.push(Legend::Entry(
+                Key::Triangle(REFERENCE_COLOUR),
+                "Multiscatter GGX".into(),
+            ));
+        }
+        // On top, so it shows through curves that lie on it.
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x_lo, 100.0), (x_hi, 100.0)],
+                8,
+                5,
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| fail(&e))?;
+        legend.push(Legend::Heading("Target".into(), BLACK));
+        legend.push(Legend::Entry(Key::Dashed(BLACK.into(), 1), "100 %".into()));
+        if tolerance > 0.0 {
+            legend.push(Legend::Entry(
+                Key::Band(PASS_BAND.mix(0.12)),
+                format!("100 % ± {tolerance} % (pass)"),
+            ));
+        }
+        draw_legend(&legend_area, &legend).map_err(|e| fail(&e))?;
+        root.present().map_err(|e| fail(&e))?;
+    }
+    write_png(&rgb, (w, h), out)
+}
+
+/// Width of the legend panel to the right of the plot.
+const LEGEND_WIDTH: i32 = 215;
+const PASS_BAND: RGBColor = RGBColor(0, 150, 0);
+
+/// One line of the plot's legend.
+enum Legend {
+    Heading(String, RGBColor),
+    Entry(Key, String),
+}
+
+/// The sample drawn in front of a legend entry.
+enum Key {
+    Hollow(RGBColor),
+    Filled(RGBColor),
+    Triangle(RGBColor),
+    Solid(RGBAColor),
+    Dashed(RGBAColor, u32),
+    Band(RGBAColor),
+}
+
+/// The legend as a column of headed groups in its own panel, so it never hides a point.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    items: &[Legend],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let line = 19;
+    let left = Pos::new(HPos::Left, VPos::Center);
+    let mut y = 24;
+    for item in items {
+        match item {
+            Legend::Heading(text, c) => {
+                y += 6;
+                let style = TextStyle::from((FAMILY, 14).into_font()).color(c).pos(left);
+                area.draw_text(text, &style, (8, y))?;
+            }
+            Legend::Entry(key, text) => {
+                let (x0, x1, xm) = (14, 36, 25);
+                match *key {
+                    Key::Hollow(c) => area.draw(&Circle::new((xm, y), 4, c.stroke_width(2)))?,
+                    Key::Filled(c) => area.draw(&Circle::new((xm, y), 4, c.filled()))?,
+                    Key::Triangle(c) => {
+                        area.draw(&PathElement::new([(x0, y), (x1, y)], c.stroke_width(1)))?;
+                        area.draw(&TriangleMarker::new((xm, y), 5, c.filled()))?;
+                    }
+                    Key::Solid(c) => {
+                        area.draw(&PathElement::new([(x0, y), (x1, y)], c.stroke_width(2)))?
+                    }
+                    Key::Dashed(c, width) => {
+                        let s = c.stroke_width(width);
+                        area.draw(&PathElement::new([(x0, y), (x0 + 8, y)], s))?;
+                        area.draw(&PathElement::new([(x1 - 8, y), (x1, y)], s))?;
+                    }
+                    Key::Band(c) => {
+                        area.draw(&Rectangle::new([(x0, y - 5), (x1, y + 5)], c.filled()))?
+                    }
+                }
+                let style = TextStyle::from((FAMILY, 13).into_font())
+                    .color(&BLACK)
+                    .pos(left);
+                area.draw_text(text, &style, (44, y))?;
+            }
+        }
+        y += line;
+    }
+    Ok(())
+}
+
+/// `text` if it has at most `max` characters, else `…` and its last `max − 1`.
+fn shorten(text: &str, max: usize) -> String {
+    let n = text.chars().count();
+    if n <= max {
+        text.to_string()
+    } else {
+        let tail: String = text.chars().skip(n + 1 - max).collect();
+        format!("…{tail}")
+    }
+}
+
+fn write_error(out: &Path, message: impl Display) -> Error {
+    Error::Write {
+        path: out.to_path_buf(),
+        message: message.to_string(),
+    }
+}
+
+/// Registers the embedded DejaVu Sans as plotters' `sans-serif` (once per process).
+fn register_font() -> Result<(), String> {
+    static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
+                .map_err(|_| "the embedded font DejaVuSans.ttf is unreadable".to_string())
+        })
+        .clone()
+}
+
+fn text_size(text: &str, px: f64) -> Result<(u32, u32), String> {
+    (FAMILY, px)
+        .into_font()
+        .box_size(text)
+        .map_err(|e| format!("cannot lay out the label '{text}': {e}"))
+}
+
+fn backend<'a>(
+    rgb: &'a mut [u8],
+    size: (u32, u32),
+    out: &Path,
+) -> Result<BitMapBackend<'a, RGBPixel>, Error> {
+    BitMapBackend::with_buffer_and_format(rgb, size)
+        .map_err(|e| write_error(out, format!("cannot draw: {e}")))
+}
+
+fn write_png(rgb: &[u8], (w, h): (u32, u32), out: &Path) -> Result<(), Error> {
+    let mut bytes = Vec::new();
+    PngEncoder::new(&mut bytes)
+        .write_image(rgb, w, h, ExtendedColorType::Rgb8)
+        .map_err(|e| write_error(out, format!("cannot encode PNG: {e}")))?;
+    write_atomic(out, &bytes)
+}

@@ -1,0 +1,135 @@
+//! ④ Verify: render furnace spheres in one Blender process (`plan`, `render`), read the EXR
+//! back (`image`), measure every sphere (`stats`) and judge it against 100 % and the
+//! integrator's prediction (`verdict`). The verdict is data; `crate::report` renders it.
+
+pub mod image;
+pub mod plan;
+pub mod render;
+pub mod stats;
+pub mod verdict;
+
+pub use plan::{Plan, RenderSettings, Role};
+pub use render::{RenderInfo, Rendered, render};
+pub use verdict::{Judging, ReferenceSphere, Row, Sweep, VerifyReport};
+
+use crate::Error;
+use crate::blender::{Blender, BlenderOptions};
+use crate::fit::Coefficients;
+use crate::generate::{GenerateParams, Mode};
+use crate::measure::{Distribution, Roughness};
+use crate::progress::Progress;
+
+/// What `verify` renders and how it judges it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VerifyOptions {
+    /// A preset or coefficients file (else the preset of the Blender used).
+    pub coefficients: Option<String>,
+    /// The distributions to check (empty: all the coefficients hold).
+    pub distributions: Vec<Distribution>,
+    /// The roughness values of the sweep, each once.
+    pub roughness: Vec<Roughness>,
+    pub render: RenderSettings,
+    pub mode: Mode,
+    pub judging: Judging,
+    pub blender: BlenderOptions,
+}
+
+/// The verify sweep's roughness values: 0, 0.1, …, 1.
+pub fn default_roughness() -> Vec<Roughness> {
+    Roughness::grid(11)
+}
+
+impl Default for VerifyOptions {
+    fn default() -> Self {
+        VerifyOptions {
+            coefficients: None,
+            distributions: Vec::new(),
+            roughness: default_roughness(),
+            render: RenderSettings::default(),
+            mode: Mode::Roughness,
+            judging: Judging::default(),
+            blender: BlenderOptions::default(),
+        }
+    }
+}
+
+/// A verify run: the verdict and what it was judged from.
+pub struct Verification {
+    pub report: VerifyReport,
+    pub rendered: Rendered,
+}
+
+/// Checks the options, finds Blender, then [`verify_with`]. Bad input fails before Blender
+/// is looked for.
+pub fn verify(v: &VerifyOptions, progress: &dyn Progress) -> Result<Verification, Error> {
+    check_roughness(&v.roughness)?;
+    if let Some(name) = &v.coefficients {
+        distributions_of(v, &Coefficients::load(name)?, name)?;
+    }
+    let blender = v.blender.find(progress)?;
+    verify_with(&blender, v, progress)
+}
+
+/// Renders the verify sweep in `blender` and judges it.
+pub fn verify_with(
+    blender: &Blender,
+    v: &VerifyOptions,
+    progress: &dyn Progress,
+) -> Result<Verification, Error> {
+    check_roughness(&v.roughness)?;
+    let (coefficients, source) =
+        Coefficients::load_or_preset(v.coefficients.as_deref(), blender.version)?;
+    let distributions = distributions_of(v, &coefficients, &source)?;
+    let roughness: Vec<f64> = v.roughness.iter().map(|r| r.get()).collect();
+    let plan = Plan::verify(&distributions, &roughness, v.render);
+    let mut groups = GenerateParams::new(&coefficients, &source);
+    if v.mode != Mode::Roughness {
+        groups = groups.with_view(blender.version.masking());
+    }
+    let rendered = render(blender, &plan, &groups, v.mode, v.blender.timeout, progress)?;
+    let sweep = Sweep {
+        coefficients: &coefficients,
+        source: &source,
+        distributions: &distributions,
+        roughness: &roughness,
+        mode: v.mode,
+    };
+    let report = verdict::judge(&rendered, &sweep, v.judging, blender.version)?;
+    Ok(Verification { report, rendered })
+}
+
+fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {
+    for (i, r) in roughness.iter().enumerate() {
+        if roughness[..i].contains(r) {
+            return Err(Error::input(
+                "--roughness",
+                &r.get().to_string(),
+                "each roughness once",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The distributions to check (all in the coefficients unless some are named), each of
+/// which the coefficients must hold.
+fn distributions_of(
+    v: &VerifyOptions,
+    coefficients: &Coefficients,
+    source: &str,
+) -> Result<Vec<Distribution>, Error> {
+    if v.distributions.is_empty() {
+        return Ok(coefficients.distributions.keys().copied().collect());
+    }
+    for d in &v.distributions {
+        if !coefficients.distributions.contains_key(d) {
+            let have: Vec<_> = coefficients.distributions.keys().map(|d| d.key()).collect();
+            return Err(Error::input(
+                "--distribution",
+                d.key(),
+                &format!("one the coefficients '{source}' hold: {}", have.join(", ")),
+            ));
+        }
+    }
+    Ok(v.distributions.clone())
+}

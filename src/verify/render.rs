@@ -1,0 +1,145 @@
+//! Rendering a furnace plan in one Blender process and reading the EXR back.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use super::image::{Rgba, read_rgba};
+use super::plan::Plan;
+use super::stats::{SphereStats, sphere_stats};
+use crate::Error;
+use crate::blender::{Blender, Run, command_line, run_script, runs};
+use crate::generate::{GenerateParams, Job, Mode, assemble};
+use crate::output::write_atomic;
+use crate::progress::Progress;
+
+/// How a sweep was rendered: which Blender, the settings, and how to rerun it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RenderInfo {
+    pub blender_version: String,
+    pub blender_program: String,
+    pub masking: String,
+    pub cell: u32,
+    pub samples: u32,
+    pub seed: u32,
+    pub width: usize,
+    pub height: usize,
+    pub render_seconds: f64,
+    pub log: String,
+    pub command: String,
+}
+
+/// A rendered sweep: the image, per-cell statistics (in plan order) and how it was made.
+pub struct Rendered {
+    pub image: Rgba,
+    pub stats: Vec<SphereStats>,
+    pub info: RenderInfo,
+    /// The EXR, in the run's directory beside its script and log.
+    pub exr: PathBuf,
+    pub plan: Plan,
+}
+
+/// Renders `plan` in one Blender process; `progress` follows the samples Cycles logs.
+pub fn render(
+    blender: &Blender,
+    plan: &Plan,
+    groups: &GenerateParams,
+    mode: Mode,
+    timeout: Duration,
+    progress: &dyn Progress,
+) -> Result<Rendered, Error> {
+    let run_dir = runs::new_run_dir("verify")?;
+    let exr = run_dir.join("sweep.exr");
+    let params = plan.params(groups, mode, &exr);
+    let script = run_dir.join("gloffuse-furnace.py");
+    write_atomic(&script, assemble(&params, Job::Furnace).as_bytes())?;
+    let log = run_dir.join("blender.log");
+    let run = Run {
+        blender,
+        script: &script,
+        args: Vec::new(),
+        timeout,
+        log: log.clone(),
+    };
+    let command = command_line(&run);
+
+    progress.begin(
+        &format!(
+            "rendering {} spheres in Blender {}",
+            plan.cells.len(),
+            blender.version_string
+        ),
+        u64::from(plan.settings.samples),
+    );
+    // A watcher follows Cycles' "Sample N/M" lines in the log while Blender runs.
+    let done = AtomicBool::new(false);
+    let outcome = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !done.load(Ordering::Relaxed) {
+                if let Some(s) = last_sample(&log) {
+                    progress.set(s);
+                }
+                std::thread::sleep(Duration::from_millis(200));
+            }
+        });
+        let outcome = run_script(&run);
+        done.store(true, Ordering::Relaxed);
+        outcome
+    });
+    progress.end();
+    let out = outcome?;
+    let image = read_rgba(&exr).map_err(|e| Error::Blender {
+        message: e.to_string(),
+        log: Some(log.clone()),
+        command: Some(command.clone()),
+    })?;
+    let cell = plan.settings.cell as usize;
+    let want = (plan.columns * cell, plan.rows() * cell);
+    if (image.width, image.height) != want {
+        return Err(Error::Blender {
+            message: format!(
+                "{} is {}×{} pixels; the plan needs {}×{}",
+                exr.display(),
+                image.width,
+                image.height,
+                want.0,
+                want.1
+            ),
+            log: Some(log),
+            command: Some(command),
+        });
+    }
+    let stats = (0..plan.cells.len())
+        .map(|i| sphere_stats(&image, i, plan.columns, cell, plan.settings.radius_fraction))
+        .collect();
+    let info = RenderInfo {
+        blender_version: blender.version_string.clone(),
+        blender_program: blender.program.display().to_string(),
+        masking: blender.version.masking().to_string(),
+        cell: plan.settings.cell,
+        samples: plan.settings.samples,
+        seed: plan.settings.seed,
+        width: image.width,
+        height: image.height,
+        render_seconds: out.result["render_seconds"].as_f64().unwrap_or(out.seconds),
+        log: log.display().to_string(),
+        command,
+    };
+    Ok(Rendered {
+        image,
+        stats,
+        info,
+        exr,
+        plan: plan.clone(),
+    })
+}
+
+/// The highest "Sample N/M" Cycles has logged so far.
+fn last_sample(log: &Path) -> Option<u64> {
+    let text = std::fs::read(log).ok()?;
+    let text = String::from_utf8_lossy(&text);
+    let at = text.rfind("Sample ")?;
+    let rest = &text[at + 7..];
+    let n: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+    n.parse().ok()
+}
