@@ -290,6 +290,32 @@ fn a_hang_is_killed_after_the_timeout_with_its_children() {
     }
 }
 
+/// A Blender that hangs at start-up, in its version probe: `--timeout` bounds the probes
+/// too (each would otherwise wait up to 60 s, and there are two: as an executable, then as
+/// a Python with bpy).
+#[test]
+fn a_hang_in_the_version_probe_ends_at_the_timeout() {
+    let s = setup("Blender 4.5.0", |_| String::new());
+    fs::write(&s.blender, "#!/bin/sh\nsleep 1000\n").unwrap();
+    for job in ["generate", "verify"] {
+        let start = Instant::now();
+        let out = if job == "generate" {
+            s.generate()
+        } else {
+            s.verify()
+        };
+        let took = start.elapsed();
+        check(
+            &s,
+            job,
+            &out,
+            &["did not answer within 2 s (--timeout)"],
+            false,
+        );
+        assert!(took < Duration::from_secs(10), "{job}: {took:?}");
+    }
+}
+
 #[test]
 fn a_traceback_is_quoted() {
     let s = setup("Blender 4.5.0", |_| {

@@ -69,8 +69,8 @@ fn find(program: &Path) -> Result<Blender, Error> {
     find_blender(
         &FindOptions {
             explicit: Some(program.to_path_buf()),
-            allow_provision: false,
             installer_output: InstallerOutput::Log,
+            ..FindOptions::default()
         },
         &Quiet,
     )

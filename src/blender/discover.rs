@@ -9,14 +9,15 @@
 //! never silently passed over.
 
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use super::environment::{BPY_SERIES, ENV_VAR, Environment, bpy_venv_dir, venv_python, which};
-use super::probe::{Blender, BlenderKind, Source, probe_as};
+use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, probe_as};
 use super::provision::{InstallerOutput, provision};
 use crate::Error;
 use crate::progress::Progress;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct FindOptions {
     /// From `--blender PATH`: a blender executable, or a Python that imports bpy.
     pub explicit: Option<PathBuf>,
@@ -24,6 +25,20 @@ pub struct FindOptions {
     pub allow_provision: bool,
     /// Where pip's output goes while provisioning.
     pub installer_output: InstallerOutput,
+    /// The whole search (every version probe) ends within this (`--timeout`); installing
+    /// bpy is not bounded by it.
+    pub timeout: Duration,
+}
+
+impl Default for FindOptions {
+    fn default() -> Self {
+        FindOptions {
+            explicit: None,
+            allow_provision: false,
+            installer_output: InstallerOutput::default(),
+            timeout: PROBE_TIMEOUT,
+        }
+    }
 }
 
 /// One step of the search.
@@ -116,6 +131,7 @@ pub fn find_blender_in(
     // could not be used, for the provisioning notice.
     let mut looked: Vec<String> = Vec::new();
     let mut skipped: Vec<String> = Vec::new();
+    let deadline = Instant::now() + opts.timeout;
     for step in search_plan(opts, env) {
         match step {
             Step::Absent { place } => looked.push(place),
@@ -124,7 +140,7 @@ pub fn find_blender_in(
                 program,
                 kind,
                 required,
-            } => match probe_as(&program, kind, source) {
+            } => match probe_as(&program, kind, source, deadline) {
                 Ok(b) => return Ok(b),
                 Err(e) if required => return Err(e),
                 Err(e) => {

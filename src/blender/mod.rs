@@ -33,7 +33,8 @@ pub struct BlenderOptions {
     pub provision: bool,
     /// Where pip's output goes if bpy is installed.
     pub installer_output: InstallerOutput,
-    /// Kill Blender (and its children) after this long.
+    /// Kill Blender (and its children) after this long; the search for Blender (its version
+    /// probes) also ends within it.
     pub timeout: Duration,
 }
 
@@ -56,6 +57,7 @@ impl BlenderOptions {
                 explicit: self.program.clone(),
                 allow_provision: self.provision,
                 installer_output: self.installer_output,
+                timeout: self.timeout,
             },
             progress,
         )?;

@@ -3,14 +3,15 @@
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use super::environment::{ENV_VAR, venv_python, which};
-use super::process::{Exit, run_captured, shell_join};
+use super::process::{Exit, format_seconds, run_captured, shell_join};
 use crate::Error;
 use crate::measure::BlenderVersion;
 
-/// How long a version probe may take (a cold Blender start on a slow disk can take a while).
+/// How long a version probe may take at most (a cold Blender start on a slow disk can take
+/// a while); a shorter `--timeout` bounds it further.
 pub const PROBE_TIMEOUT: Duration = Duration::from_secs(60);
 
 /// Printed by the bpy probe in front of `bpy.app.version_string`.
@@ -80,13 +81,21 @@ impl std::fmt::Display for Source {
 /// Python that imports bpy (a name starting with `python` is tried that way first). A
 /// directory is looked into for `blender` or a venv's `bin/python`.
 pub fn probe(program: &Path) -> Result<Blender, Error> {
-    probe_as(program, None, Source::Explicit)
+    probe_as(
+        program,
+        None,
+        Source::Explicit,
+        Instant::now() + PROBE_TIMEOUT,
+    )
 }
 
+/// [`probe`] as `kind` (or either), for a candidate from `source`; every probe it runs ends
+/// by `deadline`.
 pub(super) fn probe_as(
     program: &Path,
     kind: Option<BlenderKind>,
     source: Source,
+    deadline: Instant,
 ) -> Result<Blender, Error> {
     let named =
         |what: &str| Error::BlenderNotFound(format!("{source} {}: {what}", program.display()));
@@ -125,7 +134,7 @@ pub(super) fn probe_as(
     };
     let mut tried = Vec::new();
     for &k in order {
-        match probe_kind(&program, k)? {
+        match probe_kind(&program, k, deadline)? {
             Probed::Found(b) => return Ok(b),
             Probed::Not(attempt) => {
                 // Something that answered like Blender must not then be fed Python code:
@@ -168,9 +177,9 @@ enum Probed {
     Not(Attempt),
 }
 
-/// Runs one version probe. `Ok(Not)`: it did not answer as this kind. `Err`: it did, but
-/// as a Blender older than 3.0.
-fn probe_kind(program: &Path, kind: BlenderKind) -> Result<Probed, Error> {
+/// Runs one version probe, for at most [`PROBE_TIMEOUT`] and not past `deadline`.
+/// `Ok(Not)`: it did not answer as this kind. `Err`: it did, but as a Blender older than 3.0.
+fn probe_kind(program: &Path, kind: BlenderKind, deadline: Instant) -> Result<Probed, Error> {
     let mut argv: Vec<OsString> = vec![program.as_os_str().to_owned()];
     match kind {
         BlenderKind::Binary => {
@@ -192,14 +201,25 @@ fn probe_kind(program: &Path, kind: BlenderKind) -> Result<Probed, Error> {
             output,
         }))
     };
-    let (exit, output) = match run_captured(&argv, PROBE_TIMEOUT) {
+    let timeout = deadline
+        .saturating_duration_since(Instant::now())
+        .min(PROBE_TIMEOUT);
+    if timeout.is_zero() {
+        return not("was not probed: --timeout ran out".into(), String::new());
+    }
+    let (exit, output) = match run_captured(&argv, timeout) {
         Ok(r) => r,
         Err(e) => return not(format!("could not be run: {e}"), String::new()),
     };
     match exit {
         Exit::TimedOut => {
+            let limit = if timeout < PROBE_TIMEOUT {
+                " (--timeout)"
+            } else {
+                ""
+            };
             return not(
-                format!("did not answer within {} s", PROBE_TIMEOUT.as_secs()),
+                format!("did not answer within {} s{limit}", format_seconds(timeout)),
                 output,
             );
         }

@@ -7,6 +7,7 @@ use std::fs::File;
 use std::os::fd::AsFd;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::time::Instant;
 
 use super::environment::{BPY_REQUIREMENT, BPY_SERIES, ENV_VAR, Environment, venv_python, which};
 use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, last_lines, probe_as};
@@ -132,7 +133,12 @@ pub(super) fn provision(
     pip.push(BPY_REQUIREMENT.into());
     step(pip)?;
     // Check the install before it is given the name that makes it look valid.
-    probe_as(&tmp_python, Some(BlenderKind::PythonModule), Source::Cache)?;
+    probe_as(
+        &tmp_python,
+        Some(BlenderKind::PythonModule),
+        Source::Cache,
+        Instant::now() + PROBE_TIMEOUT,
+    )?;
     if let Err(e) = std::fs::rename(tmp.path(), venv) {
         // Another gloffuse may have finished first; use its venv (ours is removed on drop).
         if !venv_python(venv).exists() {
@@ -145,6 +151,7 @@ pub(super) fn provision(
         &venv_python(venv),
         Some(BlenderKind::PythonModule),
         Source::Cache,
+        Instant::now() + PROBE_TIMEOUT,
     ) {
         Ok(b) => Ok(b),
         Err(e) => {
