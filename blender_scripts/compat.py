@@ -5,7 +5,7 @@
 #
 # One part of the script the gloffuse binary concatenates: header
 # (GLOFFUSE_PARAMS), compat.py, params.py, nodes.py, roughness_groups.py,
-# view_groups.py, groups.py, runtime.py, then a main (generate_main.py or
+# normal_group.py, view_groups.py, groups.py, runtime.py, then a main (generate_main.py or
 # furnace_main.py). It defines functions and constants only.
 # ---------------------------------------------------------------------------
 import bpy
@@ -17,6 +17,27 @@ import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is i
 def blender_version_string():
     """Blender's version as "major.minor.patch" (no "LTS" suffix)."""
     return ".".join(str(part) for part in bpy.app.version)
+
+
+def masking_family(height_correlated_from):
+    """The masking family of this Blender's Cycles: "height-correlated" from
+    the version the parameter document names (3.5), "separable" before it."""
+    first = tuple(int(part) for part in height_correlated_from)
+    return "height-correlated" if tuple(bpy.app.version[:2]) >= first else "separable"
+
+
+def valid_reflection_rule():
+    """How Cycles raises a shading normal whose mirror reflection would dip
+    below the surface (docs/PHYSICS.md §7): "3.0" (every BSDF, two candidate
+    roots checked; Blender 3.0-3.5) or "3.6" (specular lobes only, one
+    closed-form root; Blender 3.6 and later)."""
+    return "3.6" if tuple(bpy.app.version[:2]) >= (3, 6) else "3.0"
+
+
+def has_bump_map_correction():
+    """The material setting Bump Map Correction (on by default), which can
+    switch the normal correction off, exists from Blender 4.1."""
+    return tuple(bpy.app.version[:2]) >= (4, 1)
 
 
 def max_name_bytes():

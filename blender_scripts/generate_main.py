@@ -8,7 +8,8 @@
 #
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
 # Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
-# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py and runtime.py.
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
+# groups.py and runtime.py.
 # ---------------------------------------------------------------------------
 import sys  # also imported by runtime.py; repeated so this file reads on its own
 

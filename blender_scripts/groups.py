@@ -3,25 +3,35 @@
 # of the parameter document is built.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
 # runtime.py, then a main. Functions only.
 #
-#   build_all(params) -> [(spec, [trees...]), ...]
+#   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
+#                                                     params.py's resolve_params)
 # ---------------------------------------------------------------------------
 
 def build_all(params):
-    """Build (or rebuild in place) every group in params["groups"]: for each
-    spec the roughness-only pair, and with spec["view"] also the view pair and
-    the multiscatter group. Returns [(spec, [trees...]), ...] in document order."""
+    """Build (or rebuild in place) every group of the resolved parameters
+    (params.py's resolve_params): for each spec the roughness-only pair, and
+    with spec["view"] the view pair and/or the multiscatter group it names, after
+    the shared normal group they use. Returns [(spec, [trees...]), ...] in
+    document order; the normal group comes first with the first view spec."""
     validate_params(params)
     built = []
+    normal_tree = None
     for spec in params["groups"]:
         correction = build_correction_group(spec, params)
         trees = [correction, build_shader_group(spec, params, correction)]
-        if spec.get("view"):
-            view_correction = build_view_correction_group(spec, params)
-            trees.append(view_correction)
-            trees.append(build_view_shader_group(spec, params, view_correction))
-            trees.append(build_multiscatter_group(spec, params))
+        view = spec.get("view")
+        if view:
+            if normal_tree is None:
+                normal_tree = build_normal_group(params)
+                trees.insert(0, normal_tree)
+            if view.get("correction_group"):
+                view_correction = build_view_correction_group(spec, params)
+                trees.append(view_correction)
+                trees.append(build_view_shader_group(spec, params, view_correction))
+            if view.get("multiscatter_group"):
+                trees.append(build_multiscatter_group(spec, params))
         built.append((spec, trees))
     return built

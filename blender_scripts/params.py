@@ -3,18 +3,24 @@
 # anything is built, and says what is wrong with it.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; uses
 # max_name_bytes() from compat.py.
 #
-#   load_params(text) -> dict             parse and validate the parameter JSON
-#   validate_params(params) -> params     raise ValueError saying what is wrong
+#   load_params(text) -> dict          parse the parameter JSON and resolve it
+#   resolve_params(document) -> params the document as the builders read it:
+#                                      each group with the fields of the masking
+#                                      family of the Blender this runs in
+#   validate_params(params) -> params  raise ValueError saying what is wrong
 # ---------------------------------------------------------------------------
 import json
 import math
 
 DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
 CURVE_VARIABLES = ("roughness", "alpha")
+MASKINGS = ("separable", "height-correlated")
+COLOR_MODELS = ("exact", "physical")
+VIEW_GROUPS = ("correction_group", "shader_group", "multiscatter_group")
 
 
 def finite_list(value, what):
@@ -31,15 +37,80 @@ def finite_list(value, what):
     return out
 
 
+def _name(value, where, limit, seen=None):
+    """A node-group or image name: a non-empty string within Blender's limit,
+    and (with `seen`) not used twice."""
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError("%s must be a non-empty string" % where)
+    if len(value.encode("utf-8")) > limit:
+        raise ValueError("%s %r is longer than Blender's %d-byte name limit"
+                         % (where, value, limit))
+    if seen is not None:
+        if value in seen:
+            raise ValueError("%s %r is used twice" % (where, value))
+        seen.add(value)
+
+
+def resolve_params(document):
+    """The parameter document as the builders read it. The document carries,
+    per group, one entry in "families" per masking family; this picks the one
+    of the Blender the script runs in (or the only one there is) and copies its
+    curve, description, coefficients source, image and table into the group."""
+    if not isinstance(document, dict):
+        raise ValueError("the parameter document must be a JSON object")
+    first = document.get("height_correlated_from")
+    if not (isinstance(first, list) and len(first) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) for v in first)):
+        raise ValueError("height_correlated_from must be [major, minor], got %r" % (first,))
+    masking = masking_family(first)
+    groups = document.get("groups")
+    if not isinstance(groups, list) or not groups:
+        raise ValueError("the parameter document needs a non-empty 'groups' list")
+    resolved = []
+    for index, spec in enumerate(groups):
+        where = "groups[%d]" % index
+        if not isinstance(spec, dict):
+            raise ValueError("%s must be an object" % where)
+        families = spec.get("families")
+        if not isinstance(families, list) or not families \
+                or not all(isinstance(f, dict) for f in families):
+            raise ValueError("%s.families must be a non-empty list of objects" % where)
+        for family in families:
+            if family.get("masking") not in MASKINGS:
+                raise ValueError("%s.families: masking %r is not one of %s"
+                                 % (where, family.get("masking"), ", ".join(MASKINGS)))
+        chosen = [f for f in families if f["masking"] == masking] or families
+        if len(chosen) != 1:
+            raise ValueError("%s.families holds %d entries for %s masking; expected one"
+                             % (where, len(chosen), masking))
+        family = chosen[0]
+        group = {key: value for key, value in spec.items() if key != "families"}
+        for key in ("masking", "curve", "description", "coefficients_source"):
+            group[key] = family.get(key)
+        if isinstance(spec.get("view"), dict):
+            view = dict(spec["view"])
+            view["image"] = family.get("image")
+            view["table"] = family.get("table")
+            group["view"] = view
+        resolved.append(group)
+    params = {key: value for key, value in document.items() if key != "groups"}
+    params["groups"] = resolved
+    return validate_params(params)
+
+
 def validate_params(params):
-    """Check the parameter document; raise ValueError saying what is wrong."""
+    """Check the resolved parameters; raise ValueError saying what is wrong."""
     if not isinstance(params, dict):
         raise ValueError("the parameter document must be a JSON object")
+    if params.get("color_model", "exact") not in COLOR_MODELS:
+        raise ValueError("color_model is %r; expected one of %s"
+                         % (params.get("color_model"), ", ".join(COLOR_MODELS)))
     groups = params.get("groups")
     if not isinstance(groups, list) or not groups:
         raise ValueError("the parameter document needs a non-empty 'groups' list")
     limit = max_name_bytes()
     seen = set()
+    views = False
     for index, spec in enumerate(groups):
         where = "groups[%d]" % index
         if not isinstance(spec, dict):
@@ -48,36 +119,25 @@ def validate_params(params):
             raise ValueError("%s.distribution is %r; expected one of %s"
                              % (where, spec.get("distribution"), ", ".join(DISTRIBUTIONS)))
         for key in ("correction_group", "shader_group"):
-            name = spec.get(key)
-            if not isinstance(name, str) or not name.strip():
-                raise ValueError("%s.%s must be a non-empty string" % (where, key))
-            if len(name.encode("utf-8")) > limit:
-                raise ValueError("%s.%s %r is longer than Blender's %d-byte name limit"
-                                 % (where, key, name, limit))
-            if name in seen:
-                raise ValueError("%s.%s %r is used twice" % (where, key, name))
-            seen.add(name)
+            _name(spec.get(key), "%s.%s" % (where, key), limit, seen)
         view = spec.get("view")
         if view is not None:
+            views = True
             if not isinstance(view, dict):
                 raise ValueError("%s.view must be an object" % where)
-            for key in ("correction_group", "shader_group", "multiscatter_group", "image"):
-                name = view.get(key)
-                if not isinstance(name, str) or not name.strip():
-                    raise ValueError("%s.view.%s must be a non-empty string" % (where, key))
-                if len(name.encode("utf-8")) > limit:
-                    raise ValueError("%s.view.%s %r is longer than Blender's %d-byte name limit"
-                                     % (where, key, name, limit))
-                if key != "image":
-                    if name in seen:
-                        raise ValueError("%s.view.%s %r is used twice" % (where, key, name))
-                    seen.add(name)
+            present = [key for key in VIEW_GROUPS if view.get(key) is not None]
+            if not present:
+                raise ValueError("%s.view names none of %s" % (where, ", ".join(VIEW_GROUPS)))
+            for key in present:
+                _name(view[key], "%s.view.%s" % (where, key), limit, seen)
+            _name(view.get("image"), "%s.view.image" % where, limit)
             table = view.get("table")
             if not isinstance(table, dict) or not all(
                     isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("width", "height")):
                 raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
-        if not isinstance(spec.get("description", ""), str):
-            raise ValueError("%s.description must be a string" % where)
+        for key in ("description", "coefficients_source"):
+            if not isinstance(spec.get(key, ""), str):
+                raise ValueError("%s.%s must be a string" % (where, key))
         curve = spec.get("curve")
         if not isinstance(curve, dict):
             raise ValueError("%s.curve must be an object" % where)
@@ -88,9 +148,11 @@ def validate_params(params):
             coeffs = finite_list(curve.get(key), "%s.curve.%s" % (where, key))
             if not any(coeffs):
                 raise ValueError("%s.curve.%s is identically zero" % (where, key))
+    if views:
+        _name(params.get("normal_group"), "normal_group", limit, seen)
     return params
 
 
 def load_params(text):
-    """Parse the JSON parameter document and validate it."""
-    return validate_params(json.loads(text))
+    """Parse the JSON parameter document and resolve it for this Blender."""
+    return resolve_params(json.loads(text))

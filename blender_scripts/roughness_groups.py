@@ -4,7 +4,7 @@
 # curve) and the shader group (a Glossy BSDF whose colour goes through it).
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only.
 #
 #   build_correction_group(spec, params) -> correction tree
@@ -41,9 +41,12 @@ def group_description(spec, params, kind):
     the group computes and where its coefficients come from."""
     curve = spec["curve"]
     if kind == "correction":
-        what = ("Brightness gain for Blender's %s Glossy BSDF: Gain = 100 / f(x), %s. "
-                "Color output = input Color \u00d7 Gain."
-                % (spec["distribution"], curve_text(curve)))
+        what = ("Brightness gain for Blender's %s Glossy BSDF: Gain = 100 / f(x), %s. %s"
+                % (spec["distribution"], curve_text(curve),
+                   "Color output = C / (1 - C (1 - 1/Gain)): the energy multiple bounces "
+                   "add is tinted by the colour (physical colour model)."
+                   if params.get("color_model") == "physical" else
+                   "Color output = input Color \u00d7 Gain."))
     else:
         what = ("Glossy BSDF (%s) whose colour is multiplied by the gain of '%s', so an "
                 "evenly lit white surface keeps its brightness as roughness grows."
@@ -154,13 +157,27 @@ def build_correction_group(spec, params):
         gain_out = gain.outputs[0]
     column += 1
 
-    mix, color_a, color_b, mix_out = multiply_color_node(nodes)
-    mix.name = "Apply gain"
-    mix.label = "Color \u00d7 Gain"
-    mix.width = NODE_WIDTH
-    mix.location = (col_x() + 50.0, 0.0)
-    links.new(group_in.outputs["Color"], color_a)
-    links.new(gain_out, color_b)
+    if params.get("color_model") == "physical":
+        # C / (1 - C (1 - E_avg)) with E_avg = 1 / Gain: the albedo of a coloured
+        # surface whose multiple bounces are tinted, Kulla and Conty's
+        # C (E_avg + Fms (1 - E_avg)) / E_avg.
+        chain = Chain(tree, frame, column=column, y=-ROW_STEP)
+        lost = chain.math("SUBTRACT", "1 - E_avg = 1 - 1 / Gain", 1.0,
+                          chain.math("DIVIDE", "E_avg = 1 / Gain", 1.0, gain_out))
+        color = group_in.outputs["Color"]
+        mix_out = chain.vector("DIVIDE", "C / (1 - C (1 - E_avg))", color,
+                               chain.vector("SUBTRACT", "1 - C (1 - E_avg)", (1.0, 1.0, 1.0),
+                                            chain.vector("SCALE", "C (1 - E_avg)", color, lost)),
+                               name="Apply gain")
+        column = chain.column + 1
+    else:
+        mix, color_a, color_b, mix_out = multiply_color_node(nodes)
+        mix.name = "Apply gain"
+        mix.label = "Color \u00d7 Gain"
+        mix.width = NODE_WIDTH
+        mix.location = (col_x() + 50.0, 0.0)
+        links.new(group_in.outputs["Color"], color_a)
+        links.new(gain_out, color_b)
 
     group_out = nodes.new("NodeGroupOutput")
     group_out.location = (col_x() + 50.0 + COLUMN_STEP, 0.0)
@@ -181,11 +198,12 @@ def build_shader_group(spec, params, correction_tree):
                               ["gloffuse", spec["distribution"]])
 
 
-def build_glossy_group(name, spec, correction_tree, description, tags):
+def build_glossy_group(name, spec, correction_tree, description, tags, sockets=None):
     """Color, Roughness, Normal -> BSDF: a Glossy BSDF of the spec's distribution
-    whose colour goes through `correction_tree` (roughness-only or view)."""
+    whose colour goes through `correction_tree` (roughness-only or view; every
+    input the two share is passed on)."""
     tree = reuse_or_create_group(name)
-    ensure_interface(tree, SHADER_SOCKETS)
+    ensure_interface(tree, sockets or SHADER_SOCKETS)
     nodes, links = tree.nodes, tree.links
 
     group_in = nodes.new("NodeGroupInput")
@@ -197,8 +215,9 @@ def build_glossy_group(name, spec, correction_tree, description, tags):
     correction.label = short_label(correction_tree.name)
     correction.width = 260.0
     correction.location = (COLUMN_STEP + 20.0, 160.0)
-    links.new(group_in.outputs["Roughness"], correction.inputs["Roughness"])
-    links.new(group_in.outputs["Color"], correction.inputs["Color"])
+    for sock in correction.inputs:
+        if sock.name in group_in.outputs:
+            links.new(group_in.outputs[sock.name], sock)
 
     glossy = glossy_node(nodes, spec["distribution"])
     glossy.name = "Glossy BSDF"

@@ -6,8 +6,7 @@ use std::time::Instant;
 
 use crate::Error;
 use crate::blender::BlenderOptions;
-use crate::fit::Coefficients;
-use crate::generate::{GenerateParams, Mode};
+use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Roughness};
 use crate::progress::{Progress, Quiet};
 use crate::verify::{Plan, RenderSettings, default_roughness, render};
@@ -42,13 +41,25 @@ pub struct BenchResult {
 /// `progress` counts the per-sphere runs.
 pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, Error> {
     let blender = b.blender.find(progress)?;
-    let (coefficients, name) = Coefficients::load_or_preset(None, blender.version)?;
-    let groups = GenerateParams::new(&coefficients, &name);
+    let groups = GenerateParams::new(
+        Curves::Presets,
+        &[blender.version.masking()],
+        &[Mode::Roughness],
+        ColorModel::Exact,
+    )?;
     let rs: Vec<f64> = b.roughness.iter().map(|r| r.get()).collect();
     let plan = Plan::verify(&Distribution::ALL, &rs, b.render);
     let timeout = b.blender.timeout;
     let start = Instant::now();
-    render(&blender, &plan, &groups, Mode::Roughness, timeout, &Quiet)?;
+    render(
+        &blender,
+        &plan,
+        &groups,
+        Mode::Roughness,
+        [1.0; 3],
+        timeout,
+        &Quiet,
+    )?;
     let one = start.elapsed().as_secs_f64();
     progress.notice(&format!(
         "one process: {} spheres in {one:.1} s",
@@ -62,7 +73,15 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
             columns: 1,
             settings: b.render,
         };
-        let rendered = render(&blender, &single, &groups, Mode::Roughness, timeout, &Quiet);
+        let rendered = render(
+            &blender,
+            &single,
+            &groups,
+            Mode::Roughness,
+            [1.0; 3],
+            timeout,
+            &Quiet,
+        );
         if let Err(e) = rendered {
             progress.end();
             return Err(e);

@@ -8,7 +8,7 @@ use crate::Error;
 use crate::blender::{Blender, BlenderOptions};
 use crate::fit::coefficients::{INTEGRATOR_DEGREE, today};
 use crate::fit::{Coefficients, FitSpec, Point, Provenance, Source, Target, Weighting};
-use crate::generate::{GenerateParams, Mode};
+use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{AlbedoIntegrator, Distribution, Glossy, Roughness};
 use crate::output::check_destination;
 use crate::progress::Progress;
@@ -81,13 +81,18 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
     let rs = grid();
     let plan = Plan::measure(&Distribution::ALL, &rs, a.render);
     // Plain spheres need no groups; the furnace script still builds them from a preset.
-    let (preset, name) = Coefficients::load_or_preset(None, blender.version)?;
-    let groups = GenerateParams::new(&preset, &name);
+    let groups = GenerateParams::new(
+        Curves::Presets,
+        &[blender.version.masking()],
+        &[Mode::Roughness],
+        ColorModel::Exact,
+    )?;
     let Rendered { stats, .. } = render(
         &blender,
         &plan,
         &groups,
         Mode::Roughness,
+        [1.0; 3],
         a.blender.timeout,
         progress,
     )?;

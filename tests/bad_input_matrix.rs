@@ -417,15 +417,9 @@ fn cases() -> Vec<Case> {
             "seed, blender-3, blender-4",
         ])
         .writes_nothing_to(&["@/g.py"]),
-        case(&[
-            "generate",
-            "--script",
-            "@/g.py",
-            "--blender-version",
-            "2.79",
-        ])
-        .says(&["'2.79'", "Blender 3.0 or later"])
-        .writes_nothing_to(&["@/g.py"]),
+        case(&["generate", "--script", "@/g.py", "--color-model", "pink"])
+            .says(&["'pink'", "exact", "physical"])
+            .writes_nothing_to(&["@/g.py"]),
         case(&["generate", "--blend", "@/g.blend", "--timeout", "0"])
             .no_blender()
             .says(&["'0' for '--timeout", "1..=86400"])

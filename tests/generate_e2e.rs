@@ -146,3 +146,98 @@ fn into_replaces_groups_in_place_and_keeps_a_backup() {
         .collect();
     assert_eq!(names.len(), 2, "{names:?}");
 }
+
+/// One script, written without any Blender, run in Blender 3.4, 4.5 and 5.0: each builds
+/// the groups of its own masking family (3.4 the blender-3 curves, 4.5 and 5.0 the
+/// blender-4 ones), measured through Cycles by check_generated.py; and `--mode view` alone
+/// builds the view groups and not the multiscatter ones, exactly the groups the summary names.
+#[test]
+fn one_script_serves_every_blender() {
+    let checker = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/blender/check_generated.py"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("gloffuse.py");
+    let out = common::gloffuse()
+        .args(["generate", "--mode", "view", "--json", "--script"])
+        .arg(&script)
+        .env("GLOFFUSE_BLENDER", "/nonexistent/blender")
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let summary: Value = serde_json::from_slice(&out).unwrap();
+    let named: Vec<&str> = summary["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g.as_str().unwrap())
+        .collect();
+    assert!(named.contains(&"Gloffuse View (GGX)"), "{named:?}");
+    assert!(
+        !named.iter().any(|g| g.contains("Multiscatter")),
+        "{named:?}"
+    );
+    for (label, blender) in common::blender::real_blenders() {
+        let preset = if label == "3.4" {
+            "blender-3"
+        } else {
+            "blender-4"
+        };
+        let blend = dir.path().join(format!("groups-{label}.blend"));
+        let run = common::blender::run_in_blender(
+            &blender,
+            &script,
+            &["--save".as_ref(), blend.as_os_str()],
+        );
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        assert!(
+            run.status.success(),
+            "Blender {label}: {stdout}{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let result: Value = stdout
+            .lines()
+            .rev()
+            .find_map(|l| l.strip_prefix("GLOFFUSE_RESULT "))
+            .map(|l| serde_json::from_str(l).unwrap())
+            .expect("a result line");
+        let built: Vec<&str> = result["groups"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|g| g.as_str().unwrap())
+            .collect();
+        assert_eq!(
+            built, named,
+            "Blender {label} builds what the summary names"
+        );
+        let expect = dir.path().join(format!("expect-{label}.json"));
+        std::fs::write(&expect, expectations(preset).to_string()).unwrap();
+        let report = dir.path().join(format!("report-{label}.json"));
+        let check = common::blender::run_in_blender(
+            &blender,
+            checker.as_ref(),
+            &[
+                "--blend".as_ref(),
+                blend.as_os_str(),
+                "--expect".as_ref(),
+                expect.as_os_str(),
+                "--out".as_ref(),
+                report.as_os_str(),
+            ],
+        );
+        let report: Value = std::fs::read_to_string(&report)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or(Value::Null);
+        assert!(
+            check.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
+            "Blender {label}: the script's groups are not {preset}'s: {}\n{}",
+            report["failures"],
+            String::from_utf8_lossy(&check.stderr)
+        );
+    }
+}

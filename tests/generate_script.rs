@@ -2,13 +2,19 @@
 //! code (checked by CPython's own parser on arbitrary Unicode, see check_script.py).
 
 use gloffuse::fit::Coefficients;
-use gloffuse::generate::{GenerateParams, Job, assemble};
+use gloffuse::generate::{ColorModel, Curves, GenerateParams, Job, Mode, assemble};
+use gloffuse::measure::Masking;
 use proptest::prelude::*;
 use std::path::Path;
 use std::process::Command;
 
 fn seed_params() -> GenerateParams {
-    GenerateParams::new(&Coefficients::load("seed").unwrap(), "seed")
+    let seed = Coefficients::load("seed").unwrap();
+    let curves = Curves::Pinned {
+        coefficients: &seed,
+        name: "seed",
+    };
+    GenerateParams::new(curves, &Masking::ALL, &[Mode::Roughness], ColorModel::Exact).unwrap()
 }
 
 /// Runs check_script.py on (script, expected parameters) pairs against a benign reference.
@@ -76,9 +82,11 @@ fn hostile_text_round_trips_and_never_becomes_code() {
         .iter()
         .map(|text| {
             let mut p = seed_params();
-            p.coefficients_source = text.to_string();
             for g in &mut p.groups {
-                g.description = format!("{text}{text}");
+                for f in &mut g.families {
+                    f.coefficients_source = text.to_string();
+                    f.description = format!("{text}{text}");
+                }
                 g.shader_group = format!("Gloffuse {text}");
             }
             (
@@ -99,8 +107,8 @@ proptest! {
             .chunks(2)
             .map(|pair| {
                 let mut p = seed_params();
-                p.coefficients_source = pair[0].clone();
-                p.groups[0].description = pair[1].clone();
+                p.groups[0].families[0].coefficients_source = pair[0].clone();
+                p.groups[0].families[1].description = pair[1].clone();
                 p.groups[1].correction_group = pair[0].clone();
                 (assemble(&p, Job::Generate), serde_json::to_value(&p).unwrap())
             })

@@ -98,6 +98,38 @@ fn render_info(cell: usize, columns: usize, rows: usize) -> RenderInfo {
     }
 }
 
+/// A row of white spheres: brightness is the rendered mean (the target is white).
+fn white_row(
+    distribution: Distribution,
+    roughness: f64,
+    uncorrected: SphereStats,
+    corrected: SphereStats,
+    predicted_uncorrected: f64,
+    pass: bool,
+) -> Row {
+    Row {
+        distribution,
+        roughness,
+        target: [1.0; 3],
+        uncorrected_brightness: uncorrected.mean,
+        brightness: corrected.mean,
+        uncorrected,
+        corrected,
+        predicted_uncorrected,
+        predicted_corrected: 1.0,
+        worst_ring: 0.0,
+        pass,
+    }
+}
+
+fn reference_sphere(roughness: f64, stats: SphereStats) -> ReferenceSphere {
+    ReferenceSphere {
+        roughness,
+        brightness: stats.mean,
+        stats,
+    }
+}
+
 fn with_mean(stats: &SphereStats, mean: f64) -> SphereStats {
     let mut s = stats.clone();
     s.mean = mean;
@@ -110,33 +142,34 @@ fn small_report(img: &Rgba) -> VerifyReport {
     let roughness = [0.1, 0.5, 0.9];
     let stats = |i| sphere_stats(img, i, 3, CELL, RADIUS_FRACTION);
     let rows = (0..3)
-        .map(|c| Row {
-            distribution: Distribution::Ggx,
-            roughness: roughness[c],
-            uncorrected: stats(c),
-            corrected: if c == 1 {
+        .map(|c| {
+            let corrected = if c == 1 {
                 with_mean(&stats(3 + c), f64::NAN)
             } else {
                 stats(3 + c)
-            },
-            predicted_uncorrected: if c == 2 {
+            };
+            let predicted = if c == 2 {
                 f64::NAN
             } else {
                 0.9 - 0.2 * c as f64
-            },
-            predicted_corrected: 1.0,
-            worst_ring: 0.0,
-            pass: false,
+            };
+            white_row(
+                Distribution::Ggx,
+                roughness[c],
+                stats(c),
+                corrected,
+                predicted,
+                false,
+            )
         })
         .collect();
     let reference = (0..3)
-        .map(|c| ReferenceSphere {
-            roughness: roughness[c],
-            stats: stats(6 + c),
-        })
+        .map(|c| reference_sphere(roughness[c], stats(6 + c)))
         .collect();
     VerifyReport {
         mode: gloffuse::generate::Mode::Roughness,
+        color: [1.0; 3],
+        color_model: gloffuse::generate::ColorModel::Exact,
         ring_tolerance_percent: 1.5,
         coefficients: "cycles-4.x".into(),
         render: render_info(CELL, 3, 3),
@@ -286,8 +319,8 @@ fn brightness_plot_of_only_nan_values_still_draws() {
     let img = grid(3, 3, CELL, small_colour);
     let mut report = small_report(&img);
     for row in &mut report.rows {
-        row.uncorrected.mean = f64::NAN;
-        row.corrected.mean = f64::NAN;
+        row.uncorrected_brightness = f64::NAN;
+        row.brightness = f64::NAN;
         row.predicted_uncorrected = f64::NAN;
         row.predicted_corrected = f64::NAN;
     }
@@ -375,27 +408,26 @@ fn full_sweep_sheet_and_plot() {
                 .enumerate()
                 .map(move |(c, &r)| (k, d, c, r))
         })
-        .map(|(k, d, c, r)| Row {
-            distribution: d,
-            roughness: r,
-            uncorrected: stats(2 * k * columns + c),
-            corrected: stats((2 * k + 1) * columns + c),
-            predicted_uncorrected: loss(k, r) * 0.9667,
-            predicted_corrected: 1.0,
-            worst_ring: 0.0,
-            pass: true,
+        .map(|(k, d, c, r)| {
+            white_row(
+                d,
+                r,
+                stats(2 * k * columns + c),
+                stats((2 * k + 1) * columns + c),
+                loss(k, r) * 0.9667,
+                true,
+            )
         })
         .collect();
     let reference = roughness
         .iter()
         .enumerate()
-        .map(|(c, &r)| ReferenceSphere {
-            roughness: r,
-            stats: stats(6 * columns + c),
-        })
+        .map(|(c, &r)| reference_sphere(r, stats(6 * columns + c)))
         .collect();
     let report = VerifyReport {
         mode: gloffuse::generate::Mode::Roughness,
+        color: [1.0; 3],
+        color_model: gloffuse::generate::ColorModel::Exact,
         ring_tolerance_percent: 1.5,
         coefficients: "presets/cycles-4.x.json".into(),
         render: render_info(cell, columns, 7),

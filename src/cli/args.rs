@@ -10,7 +10,7 @@ use std::time::Duration;
 use gloffuse::bench::BenchOptions;
 use gloffuse::blender::{BlenderOptions, InstallerOutput};
 use gloffuse::fit::{Point, Target, Weighting};
-use gloffuse::generate::{GenerateOptions, Mode};
+use gloffuse::generate::{ColorModel, GenerateOptions, Mode};
 use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Sampling};
 use gloffuse::measure::brdf::{Model, ModelParams};
 use gloffuse::measure::{BlenderVersion, Distribution, Roughness};
@@ -148,6 +148,17 @@ const MODES: &[Choice<Mode>] = &[
     ),
 ];
 
+const COLOR_MODELS: &[Choice<ColorModel>] = &[
+    choice(
+        ColorModel::Exact,
+        "the surface's albedo is exactly Color at every roughness",
+    ),
+    choice(
+        ColorModel::Physical,
+        "the energy of multiple bounces is tinted by Color (Kulla–Conty, as Multiscatter GGX does): rough coloured metals come out darker and more saturated",
+    ),
+];
+
 const TARGETS: &[Choice<Target>] = &[
     choice(
         Target::Mean,
@@ -189,7 +200,7 @@ const G_MODELS: &[Choice<GModel>] = &[
     ),
     choice(
         GModel::HeightCorrelated,
-        "Smith GGX height-correlated, G2 = 1/(1 + Λ(V) + Λ(L)) (Cycles 3.6+, Filament)",
+        "Smith GGX height-correlated, G2 = 1/(1 + Λ(V) + Λ(L)) (Cycles 3.5+, Filament)",
     ),
 ];
 
@@ -260,6 +271,23 @@ fn parse_mu(s: &str) -> Result<f64, String> {
     }
 }
 
+fn parse_color(s: &str) -> Result<[f64; 3], String> {
+    let bad = || {
+        format!(
+            "invalid colour '{s}': expected R,G,B, three numbers from 0 to 1, e.g. 0.95,0.64,0.54"
+        )
+    };
+    let values: Vec<f64> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    match values.as_slice() {
+        &[r, g, b] if values.iter().all(|v| (0.0..=1.0).contains(v)) => Ok([r, g, b]),
+        _ => Err(bad()),
+    }
+}
+
 fn parse_tolerance(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 && v <= 100.0 => Ok(v),
@@ -320,7 +348,7 @@ pub struct AlbedoArgs {
     #[arg(long, default_value = "1", value_parser = parse_mu, allow_hyphen_values = true)]
     pub mu: f64,
 
-    /// Blender version whose masking to model: 3.0–3.5 separable, 3.6 and later height-correlated.
+    /// Blender version whose masking to model: 3.0–3.4 separable, 3.5 and later height-correlated.
     #[arg(long, default_value_t = BlenderVersion::DEFAULT, value_parser = parse_version)]
     pub blender_version: BlenderVersion,
 
@@ -427,7 +455,8 @@ impl BlenderArgs {
 #[derive(Args, Debug)]
 pub struct GenerateArgs {
     /// A preset (seed, blender-3, blender-4) or a coefficients file [default: the preset of
-    /// the Blender used: blender-3 for 3.0–3.5, blender-4 for 3.6 and later].
+    /// the Blender the groups are built in: blender-3 for 3.0–3.4, blender-4 for 3.5 and
+    /// later; a script carries both and picks when it runs].
     #[arg(long, value_name = "PRESET|FILE")]
     pub coefficients: Option<String>,
 
@@ -451,9 +480,10 @@ pub struct GenerateArgs {
     #[arg(long, value_parser = one_of(MODES, Mode::key), value_delimiter = ',', default_value = Mode::Roughness.key())]
     pub mode: Vec<Mode>,
 
-    /// With only --script: the Blender version whose preset to use by default.
-    #[arg(long, default_value_t = GenerateOptions::default().blender_version, value_parser = parse_version)]
-    pub blender_version: BlenderVersion,
+    /// What a coloured correction keeps: exact (the surface's albedo is Color) or physical
+    /// (multiple bounces tint and darken a coloured rough surface, as in Multiscatter GGX).
+    #[arg(long, value_parser = one_of(COLOR_MODELS, ColorModel::key), default_value = GenerateOptions::default().color_model.key())]
+    pub color_model: ColorModel,
 
     #[command(flatten)]
     pub blender: BlenderArgs,
@@ -471,7 +501,7 @@ impl GenerateArgs {
             blend: self.blend.clone(),
             into: self.into.clone(),
             modes: self.mode.clone(),
-            blender_version: self.blender_version,
+            color_model: self.color_model,
             blender: self.blender.options(false),
         }
     }
@@ -515,6 +545,15 @@ pub struct VerifyArgs {
     #[arg(long, value_parser = one_of(MODES, Mode::key), default_value = verify_defaults().mode.key())]
     pub mode: Mode,
 
+    /// The spheres' colour as linear R,G,B, each 0 to 1 (e.g. 0.95,0.64,0.54, a copper).
+    #[arg(long, value_name = "R,G,B", value_parser = parse_color, default_value = "1,1,1")]
+    pub color: [f64; 3],
+
+    /// What a correction promises for a colour: exact (the sphere's albedo is the colour) or
+    /// physical (tinted multiple bounces, as Multiscatter GGX); the spheres are judged by it.
+    #[arg(long, value_parser = one_of(COLOR_MODELS, ColorModel::key), default_value = verify_defaults().color_model.key())]
+    pub color_model: ColorModel,
+
     /// In the view modes: allowed |mean − 100 %| of every view-cosine ring, in percent.
     #[arg(long, default_value_t = verify_defaults().judging.ring_tolerance_percent, value_parser = parse_tolerance)]
     pub ring_tolerance: f64,
@@ -544,6 +583,8 @@ impl VerifyArgs {
                 ..RenderSettings::default()
             },
             mode: self.mode,
+            color: self.color,
+            color_model: self.color_model,
             judging: Judging {
                 tolerance_percent: self.tolerance,
                 ring_tolerance_percent: self.ring_tolerance,
@@ -641,7 +682,7 @@ pub struct LutArgs {
     #[arg(long, short = 'd', value_parser = parse_distribution)]
     pub distribution: Option<Distribution>,
 
-    /// kulla-conty and albedo: the Blender whose masking the BSDF follows (3.x separable, 3.6+ height-correlated) [default: 4.5].
+    /// kulla-conty and albedo: the Blender whose masking the BSDF follows (3.0–3.4 separable, 3.5+ height-correlated) [default: 4.5].
     #[arg(long, value_parser = parse_version)]
     pub blender_version: Option<BlenderVersion>,
 

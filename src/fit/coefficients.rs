@@ -26,18 +26,23 @@ pub const PRESETS: [(&str, &str, &str); 3] = [
     (
         "blender-3",
         include_str!("../../presets/blender-3.json"),
-        "linear-space fits to E_avg for Blender 3.0–3.5 (separable masking)",
+        "linear-space fits to E_avg for Blender 3.0–3.4 (separable masking)",
     ),
     (
         "blender-4",
         include_str!("../../presets/blender-4.json"),
-        "linear-space fits to E_avg for Blender 3.6, 4.x and 5.x (height-correlated masking)",
+        "linear-space fits to E_avg for Blender 3.5 and later (height-correlated masking)",
     ),
 ];
 
 /// The preset fitted for `version`'s masking family: `blender-3` or `blender-4`.
 pub fn preset_for(version: BlenderVersion) -> &'static str {
-    match version.masking() {
+    preset_for_masking(version.masking())
+}
+
+/// The preset fitted for a masking family.
+pub fn preset_for_masking(masking: Masking) -> &'static str {
+    match masking {
         Masking::Separable => "blender-3",
         Masking::HeightCorrelated => "blender-4",
     }

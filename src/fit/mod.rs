@@ -4,7 +4,9 @@
 pub mod coefficients;
 pub mod curve;
 
-pub use coefficients::{Coefficients, ColorSpace, FitSpec, Provenance, Source, Target, preset_for};
+pub use coefficients::{
+    Coefficients, ColorSpace, FitSpec, Provenance, Source, Target, preset_for, preset_for_masking,
+};
 pub use curve::{Curve, Fit, Point, Residuals, Variable, Weighting, fit_polynomial};
 
 use crate::Error;

@@ -6,8 +6,10 @@ pub mod blend;
 pub mod params;
 pub mod script;
 
-pub use params::{GenerateParams, GroupSpec, Mode, correction_group_name, shader_group_name};
-pub use script::{Job, assemble};
+pub use params::{
+    ColorModel, Curves, GenerateParams, GroupSpec, Mode, correction_group_name, shader_group_name,
+};
+pub use script::{Job, assemble, assemble_parts};
 
 use serde::Serialize;
 use std::ffi::OsString;
@@ -15,8 +17,8 @@ use std::path::PathBuf;
 
 use crate::Error;
 use crate::blender::{BlenderOptions, Run, command_line, run_script};
-use crate::fit::Coefficients;
-use crate::measure::BlenderVersion;
+use crate::fit::{Coefficients, preset_for};
+use crate::measure::{BlenderVersion, Masking};
 use crate::output::{check_destination, write_atomic};
 use crate::progress::Progress;
 use blend::{incomplete_blend, starts_like_blend, temp_beside};
@@ -34,8 +36,7 @@ pub struct GenerateOptions {
     pub into: Option<PathBuf>,
     /// Which groups to build besides the roughness-only pair.
     pub modes: Vec<Mode>,
-    /// With only `script`: the Blender version whose preset and masking to use.
-    pub blender_version: BlenderVersion,
+    pub color_model: ColorModel,
     pub blender: BlenderOptions,
 }
 
@@ -47,7 +48,7 @@ impl Default for GenerateOptions {
             blend: None,
             into: None,
             modes: vec![Mode::Roughness],
-            blender_version: BlenderVersion::DEFAULT,
+            color_model: ColorModel::Exact,
             blender: BlenderOptions::default(),
         }
     }
@@ -96,50 +97,39 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     }
     let needs_blender = g.blend.is_some() || g.into.is_some();
     // Coefficients are checked before Blender is looked for: bad input fails fast.
-    let explicit = g
+    let pinned = g
         .coefficients
         .as_deref()
-        .map(|name| Coefficients::load_or_preset(Some(name), g.blender_version))
+        .map(|name| Coefficients::load(name).map(|c| (c, name)))
         .transpose()?;
     let blender = if needs_blender {
         Some(g.blender.find(progress)?)
     } else {
         None
     };
-    let version: BlenderVersion = blender
-        .as_ref()
-        .map(|b| b.version)
-        .unwrap_or(g.blender_version);
-    let (coefficients, source) = match explicit {
-        Some(named) => named,
-        None => Coefficients::load_or_preset(None, version)?,
+    // The script carries both masking families and picks the one of the Blender it runs
+    // in, so one script serves every version.
+    let curves = match &pinned {
+        Some((coefficients, name)) => Curves::Pinned { coefficients, name },
+        None => Curves::Presets,
     };
-    let mut params = GenerateParams::new(&coefficients, &source);
-    if g.modes.iter().any(|m| *m != Mode::Roughness) {
-        params = params.with_view(version.masking());
-    }
+    let params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
     let script = assemble(&params, Job::Generate);
     let mut out = Generated {
         blender: blender.as_ref().map(|b| b.version_string.clone()),
-        coefficients: source,
+        coefficients: match (&pinned, &blender) {
+            (Some((_, name)), _) => name.to_string(),
+            (None, Some(b)) => preset_for(b.version).to_string(),
+            (None, None) => format!(
+                "{} or {}, for the Blender the script runs in",
+                preset_for(BlenderVersion::OLDEST),
+                preset_for(BlenderVersion::HEIGHT_CORRELATED_FROM)
+            ),
+        },
         script: None,
         blend: None,
         backup: None,
-        groups: params
-            .groups
-            .iter()
-            .flat_map(|s| {
-                let mut names = vec![s.correction_group.clone(), s.shader_group.clone()];
-                if let Some(v) = &s.view {
-                    names.extend([
-                        v.correction_group.clone(),
-                        v.shader_group.clone(),
-                        v.multiscatter_group.clone(),
-                    ]);
-                }
-                names
-            })
-            .collect(),
+        groups: params.group_names(),
         log: None,
     };
     let Some(blender) = blender else {

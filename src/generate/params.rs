@@ -4,8 +4,9 @@
 
 use serde::Serialize;
 
-use crate::fit::{Coefficients, ColorSpace, Curve, Target};
-use crate::measure::{AlbedoIntegrator, Distribution, Masking, Roughness};
+use crate::Error;
+use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
+use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Masking, Roughness};
 use crate::progress::Quiet;
 
 /// Which correction a shader group applies.
@@ -32,18 +33,44 @@ impl Mode {
     }
 }
 
+/// What a coloured correction keeps (`--color-model`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ColorModel {
+    /// The surface's albedo is exactly `Color`, whatever the roughness.
+    Exact,
+    /// The energy multiple bounces add is tinted by the colour, as Kulla and Conty (and
+    /// Blender's Multiscatter GGX) compute it: `Fms = F·E_avg / (1 − F(1 − E_avg))`, so a rough
+    /// coloured metal renders darker and more saturated than `Color`.
+    Physical,
+}
+
+impl ColorModel {
+    pub const ALL: [ColorModel; 2] = [ColorModel::Exact, ColorModel::Physical];
+
+    pub fn key(self) -> &'static str {
+        match self {
+            ColorModel::Exact => "exact",
+            ColorModel::Physical => "physical",
+        }
+    }
+}
+
 /// Side of the E(μ, r) table packed into the .blend for the view and multiscatter modes:
 /// bilinear interpolation of 96 × 96 samples stays within 0.33 % of E for μ ≥ 0.05
 /// (`cargo run --release --example view_table_error`).
 pub const VIEW_TABLE_SIZE: usize = 96;
 
-/// E(μ, r) on a grid: row i is μ = i/(height − 1), column j is r = j/(width − 1).
+/// E(μ, r) on a grid (row i is μ = i/(height − 1), column j is r = j/(width − 1)) and
+/// E_avg(r) per column.
 #[derive(Clone, Debug, Serialize)]
 pub struct AlbedoTable {
     pub width: usize,
     pub height: usize,
     /// Row-major; f32 because Blender stores image pixels as 32-bit floats.
     pub values: Vec<f32>,
+    /// `E_avg(r_j)`, one per column (the physical colour model needs it).
+    pub average: Vec<f32>,
 }
 
 impl AlbedoTable {
@@ -55,27 +82,45 @@ impl AlbedoTable {
             .map(|mu| mu.get().max(1e-3))
             .collect();
         let grid = integrator.grid(distribution, masking, &Roughness::grid(size), &mus, &Quiet);
-        let values = grid.e.into_iter().map(|e| e as f32).collect();
         AlbedoTable {
             width: size,
             height: size,
-            values,
+            values: grid.e.into_iter().map(|e| e as f32).collect(),
+            average: grid.e_avg.into_iter().map(|e| e as f32).collect(),
         }
     }
 }
 
-/// The view-dependent groups of one distribution and the table they sample.
+/// The names of the view-dependent groups of one distribution; a name is there when a
+/// mode asks for its group.
 #[derive(Clone, Debug, Serialize)]
-pub struct ViewSpec {
-    pub correction_group: String,
-    pub shader_group: String,
-    pub multiscatter_group: String,
-    /// Name of the packed float image holding the table.
-    pub image: String,
-    pub table: AlbedoTable,
+pub struct ViewNames {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correction_group: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shader_group: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multiscatter_group: Option<String>,
 }
 
-/// One distribution's node groups, as the Python side builds them.
+/// What one masking family (one Blender version range) builds for a distribution: the
+/// curve, its description, and the packed E(μ, r) table of the view modes.
+#[derive(Clone, Debug, Serialize)]
+pub struct FamilySpec {
+    pub masking: Masking,
+    /// The preset or file the curve comes from, for the descriptions.
+    pub coefficients_source: String,
+    pub description: String,
+    pub curve: Curve,
+    /// Name of the packed float image holding `table` (view modes only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub image: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table: Option<AlbedoTable>,
+}
+
+/// One distribution's node groups, as the Python side builds them. The script picks the
+/// family of the Blender it runs in (see [`GenerateParams::height_correlated_from`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct GroupSpec {
     /// Written as Blender's enum for the Glossy node's distribution (`GGX`, …).
@@ -83,31 +128,65 @@ pub struct GroupSpec {
     pub distribution: Distribution,
     pub correction_group: String,
     pub shader_group: String,
-    pub description: String,
-    pub curve: Curve,
     /// The view and multiscatter groups (only when a mode asks for them).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub view: Option<ViewSpec>,
+    pub view: Option<ViewNames>,
+    pub families: Vec<FamilySpec>,
 }
 
 impl GroupSpec {
     /// The shader group a furnace sphere of this mode is shaded with.
     pub fn shader_for(&self, mode: Mode) -> Option<&str> {
+        let view = self.view.as_ref();
         match mode {
             Mode::Roughness => Some(&self.shader_group),
-            Mode::View => self.view.as_ref().map(|v| v.shader_group.as_str()),
-            Mode::Multiscatter => self.view.as_ref().map(|v| v.multiscatter_group.as_str()),
+            Mode::View => view.and_then(|v| v.shader_group.as_deref()),
+            Mode::Multiscatter => view.and_then(|v| v.multiscatter_group.as_deref()),
         }
     }
+
+    /// Every group name this spec builds, in build order.
+    pub fn group_names(&self) -> Vec<String> {
+        let mut names = vec![self.correction_group.clone(), self.shader_group.clone()];
+        if let Some(v) = &self.view {
+            let view = [&v.correction_group, &v.shader_group, &v.multiscatter_group];
+            names.extend(view.into_iter().flatten().cloned());
+        }
+        names
+    }
+}
+
+/// Where the curves come from.
+#[derive(Clone, Copy, Debug)]
+pub enum Curves<'a> {
+    /// One coefficients file (or preset) for every family; `name` is what it was loaded by.
+    Pinned {
+        coefficients: &'a Coefficients,
+        name: &'a str,
+    },
+    /// Each family's own preset (`blender-3` for separable, `blender-4` for
+    /// height-correlated masking).
+    Presets,
 }
 
 /// The parameter document of the generate job.
 #[derive(Clone, Debug, Serialize)]
 pub struct GenerateParams {
     pub gloffuse_version: &'static str,
-    pub coefficients_source: String,
+    /// The first Blender version whose Cycles uses height-correlated masking: the script
+    /// builds the separable family in older versions, the height-correlated one from this
+    /// version on (or the only family it carries).
+    pub height_correlated_from: [u32; 2],
+    pub color_model: ColorModel,
+    /// The helper group every view-dependent group uses for the normal the BSDF shades
+    /// with (only when a view mode is asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normal_group: Option<String>,
     pub groups: Vec<GroupSpec>,
 }
+
+/// The public name of the helper group that finds the normal a glossy BSDF shades with.
+pub const NORMAL_GROUP: &str = "Gloffuse Shading Normal";
 
 /// `Brightness Correction (GGX)`: the public name of the gain group.
 pub fn correction_group_name(d: Distribution) -> String {
@@ -120,55 +199,97 @@ pub fn shader_group_name(d: Distribution) -> String {
 }
 
 impl GenerateParams {
-    /// The groups for every distribution in `coefficients`; `source` names where the
-    /// coefficients came from (a preset name or a file path) for the descriptions.
-    pub fn new(coefficients: &Coefficients, source: &str) -> Self {
-        let groups = coefficients
-            .distributions
-            .iter()
-            .map(|(&d, e)| GroupSpec {
+    /// The groups for every distribution the curves hold, for each masking family in
+    /// `families`, with the view-dependent groups `modes` ask for.
+    pub fn new(
+        curves: Curves,
+        families: &[Masking],
+        modes: &[Mode],
+        color_model: ColorModel,
+    ) -> Result<Self, Error> {
+        let mut loaded = Vec::new();
+        for &masking in families {
+            let (coefficients, name) = match curves {
+                Curves::Pinned { coefficients, name } => (coefficients.clone(), name.to_string()),
+                Curves::Presets => {
+                    let name = preset_for_masking(masking);
+                    (Coefficients::load(name)?, name.to_string())
+                }
+            };
+            loaded.push((masking, coefficients, name));
+        }
+        let wants = |m: Mode| modes.contains(&m);
+        let views = wants(Mode::View) || wants(Mode::Multiscatter);
+        let distributions: Vec<Distribution> = loaded
+            .first()
+            .map(|(_, c, _)| c.distributions.keys().copied().collect())
+            .unwrap_or_default();
+        let groups = distributions
+            .into_iter()
+            .map(|d| GroupSpec {
                 distribution: d,
                 correction_group: correction_group_name(d),
                 shader_group: shader_group_name(d),
-                description: format!(
-                    "Restores a white {} Glossy BSDF to 100 % brightness under even light: gain = 100 / f(r), fitted to the sphere's {} brightness ({} masking{}). Coefficients: {}.",
-                    d.label(),
-                    match e.target {
-                        Target::Mean => "mean",
-                        Target::Center => "centre",
-                    },
-                    e.masking,
-                    match e.color_space {
-                        ColorSpace::Linear => "",
-                        ColorSpace::Display => "; display-referred percentages, not a true linear gain",
-                    },
-                    source
-                ),
-                curve: e.curve.clone(),
-                view: None,
+                view: views.then(|| ViewNames {
+                    correction_group: wants(Mode::View)
+                        .then(|| format!("Brightness Correction View ({})", d.label())),
+                    shader_group: wants(Mode::View)
+                        .then(|| format!("Gloffuse View ({})", d.label())),
+                    multiscatter_group: wants(Mode::Multiscatter)
+                        .then(|| format!("Gloffuse Multiscatter ({})", d.label())),
+                }),
+                families: loaded
+                    .iter()
+                    .filter_map(|(masking, c, name)| {
+                        let e = c.distributions.get(&d)?;
+                        Some(FamilySpec {
+                            masking: *masking,
+                            coefficients_source: format!("{name} ({})", c.name),
+                            description: describe(d, e, name),
+                            curve: e.curve.clone(),
+                            image: views
+                                .then(|| format!("Gloffuse E(mu, r) ({}, {})", d.label(), masking)),
+                            table: views
+                                .then(|| AlbedoTable::compute(d, *masking, VIEW_TABLE_SIZE)),
+                        })
+                    })
+                    .collect(),
             })
             .collect();
-        GenerateParams {
+        let first = BlenderVersion::HEIGHT_CORRELATED_FROM;
+        Ok(GenerateParams {
             gloffuse_version: env!("CARGO_PKG_VERSION"),
-            coefficients_source: format!("{source} ({})", coefficients.name),
+            height_correlated_from: [first.major, first.minor],
+            color_model,
+            normal_group: views.then(|| NORMAL_GROUP.to_string()),
             groups,
-        }
+        })
     }
 
-    /// Adds the view and multiscatter groups, with E(μ, r) for `masking` from the integrator.
-    pub fn with_view(mut self, masking: Masking) -> Self {
-        for g in &mut self.groups {
-            let d = g.distribution;
-            g.view = Some(ViewSpec {
-                correction_group: format!("Brightness Correction View ({})", d.label()),
-                shader_group: format!("Gloffuse View ({})", d.label()),
-                multiscatter_group: format!("Gloffuse Multiscatter ({})", d.label()),
-                image: format!("Gloffuse E(mu, r) ({}, {})", d.label(), masking),
-                table: AlbedoTable::compute(d, masking, VIEW_TABLE_SIZE),
-            });
-        }
-        self
+    /// Every group name the script builds, in build order.
+    pub fn group_names(&self) -> Vec<String> {
+        let groups = self.groups.iter().flat_map(GroupSpec::group_names);
+        self.normal_group.iter().cloned().chain(groups).collect()
     }
+}
+
+/// The description of a distribution's groups: what the curve restores and where it comes
+/// from.
+fn describe(d: Distribution, e: &crate::fit::coefficients::Entry, source: &str) -> String {
+    format!(
+        "Restores a white {} Glossy BSDF to 100 % brightness under even light: gain = 100 / f(r), fitted to the sphere's {} brightness ({} masking{}). Coefficients: {}.",
+        d.label(),
+        match e.target {
+            Target::Mean => "mean",
+            Target::Center => "centre",
+        },
+        e.masking,
+        match e.color_space {
+            ColorSpace::Linear => "",
+            ColorSpace::Display => "; display-referred percentages, not a true linear gain",
+        },
+        source
+    )
 }
 
 fn as_blender_enum<S: serde::Serializer>(d: &Distribution, s: S) -> Result<S::Ok, S::Error> {

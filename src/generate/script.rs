@@ -9,13 +9,17 @@ use serde::Serialize;
 
 /// The library parts, in the order they are concatenated: each defines functions only,
 /// and may use what the parts before it define (see `docs/ARCHITECTURE.md`).
-pub const PARTS: [(&str, &str); 7] = [
+pub const PARTS: [(&str, &str); 8] = [
     ("compat.py", include_str!("../../blender_scripts/compat.py")),
     ("params.py", include_str!("../../blender_scripts/params.py")),
     ("nodes.py", include_str!("../../blender_scripts/nodes.py")),
     (
         "roughness_groups.py",
         include_str!("../../blender_scripts/roughness_groups.py"),
+    ),
+    (
+        "normal_group.py",
+        include_str!("../../blender_scripts/normal_group.py"),
     ),
     (
         "view_groups.py",
@@ -28,7 +32,14 @@ pub const PARTS: [(&str, &str); 7] = [
     ),
 ];
 
-/// What a script does when it runs: the main appended after the library.
+/// The furnace scene (world, camera, spheres, render settings, EXR output): a part of the
+/// scripts that render, after [`PARTS`].
+pub const FURNACE_PART: (&str, &str) = (
+    "furnace.py",
+    include_str!("../../blender_scripts/furnace.py"),
+);
+
+/// What a script does when it runs: the parts appended after the library, main last.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Job {
     /// Build (or update) the node groups in the open or named .blend, and save it.
@@ -38,23 +49,33 @@ pub enum Job {
 }
 
 impl Job {
-    /// The file name and text of the job's main.
-    pub fn main(self) -> (&'static str, &'static str) {
+    /// The job's parts after [`PARTS`], its main last.
+    pub fn parts(self) -> Vec<(&'static str, &'static str)> {
         match self {
-            Job::Generate => (
+            Job::Generate => vec![(
                 "generate_main.py",
                 include_str!("../../blender_scripts/generate_main.py"),
-            ),
-            Job::Furnace => (
-                "furnace_main.py",
-                include_str!("../../blender_scripts/furnace_main.py"),
-            ),
+            )],
+            Job::Furnace => vec![
+                FURNACE_PART,
+                (
+                    "furnace_main.py",
+                    include_str!("../../blender_scripts/furnace_main.py"),
+                ),
+            ],
         }
     }
 }
 
-/// The full script: header with the parameter literal, the library parts, then the main.
+/// The full script of a job: header with the parameter literal, the library parts, then
+/// the job's own parts.
 pub fn assemble(params: &impl Serialize, job: Job) -> String {
+    assemble_parts(params, &job.parts())
+}
+
+/// A script of the library parts followed by `parts` (their names label them in the
+/// script): how every script is made, and how tests run a main of their own.
+pub fn assemble_parts(params: &impl Serialize, parts: &[(&str, &str)]) -> String {
     let document = serde_json::to_string(params).expect("parameters serialise");
     let literal = serde_json::to_string(&document).expect("a string serialises");
     let mut s = format!(
@@ -63,7 +84,7 @@ pub fn assemble(params: &impl Serialize, job: Job) -> String {
          GLOFFUSE_PARAMS = {literal}\n",
         env!("CARGO_PKG_VERSION")
     );
-    for (name, text) in PARTS.into_iter().chain([job.main()]) {
+    for &(name, text) in PARTS.iter().chain(parts) {
         s.push_str(&format!("\n# ======== gloffuse part: {name} ========\n"));
         s.push_str(text);
         if !text.ends_with('\n') {

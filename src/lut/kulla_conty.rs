@@ -16,7 +16,7 @@
 //!   `Fc = (1 − |V·H|)⁵`, f the Cycles BSDF (masking from `--blender-version`), estimated with
 //!   N Hammersley samples of Cycles' own importance sampling (GGX: its visible normals, as
 //!   in the split-sum table; see [`scale_bias`]). So `R + G → E(μ, r)`, and for GGX with
-//!   height-correlated masking (Blender ≥ 3.6) R and G are the split-sum table with
+//!   height-correlated masking (Blender ≥ 3.5) R and G are the split-sum table with
 //!   `--g-model height-correlated`. At run time, `F0 · R + G` is the single-scattering
 //!   response with Schlick's Fresnel.
 //! * **B** = `∫ f_ms(μ, μi) cosθi dωi = (1 − E(μ)) (1 − Ē) / (1 − E_avg)`, in closed form

@@ -86,7 +86,7 @@ impl Kind {
 pub enum GModel {
     /// Separable Schlick-GGX with k = α/2 (Karis' UE4 table).
     Ue4,
-    /// Smith GGX height-correlated, G2 = 1/(1 + Λ(V) + Λ(L)) (Cycles 3.6+, Filament).
+    /// Smith GGX height-correlated, G2 = 1/(1 + Λ(V) + Λ(L)) (Cycles 3.5+, Filament).
     HeightCorrelated,
 }
 

@@ -95,6 +95,8 @@ pub enum Masking {
 }
 
 impl Masking {
+    pub const ALL: [Masking; 2] = [Masking::Separable, Masking::HeightCorrelated];
+
     pub fn key(self) -> &'static str {
         match self {
             Masking::Separable => "separable",
@@ -122,7 +124,7 @@ impl Roughness {
             Err(Error::input(
                 "roughness",
                 &value.to_string(),
-                "a number from 0 to 1 (Blender clamps the Roughness socket to [0, 1])",
+                "a number from 0 to 1 (the Glossy node's Roughness range)",
             ))
         }
     }

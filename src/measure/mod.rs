@@ -1,11 +1,13 @@
 //! ① Measure: the physics. The microfacet distributions (`microfacet`), the Glossy BSDF as
 //! Cycles evaluates it (`glossy`), its albedo by quadrature (`albedo`), the masking family of
-//! each Blender version (`version`), and the classic BRDF set (`brdf`).
+//! each Blender version (`version`), the normal a glossy BSDF shades with (`shading_normal`),
+//! and the classic BRDF set (`brdf`).
 
 pub mod albedo;
 pub mod brdf;
 pub mod glossy;
 pub mod microfacet;
+pub mod shading_normal;
 pub mod version;
 
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};

@@ -18,14 +18,15 @@ impl BlenderVersion {
     /// The version modelled when none is named: 4.5 LTS, the series gloffuse installs.
     pub const DEFAULT: BlenderVersion = BlenderVersion { major: 4, minor: 5 };
 
-    /// The masking–shadowing form Cycles uses in this version.
-    ///
-    /// Cycles' microfacet refactor switched from the separable `G1(ωi) G1(ωo)` to the
-    /// height-correlated `1/(1 + Λi + Λo)`; the 3.6-era source already has the
-    /// height-correlated form, the 3.4 source the separable one (3.5 is unconfirmed and
-    /// treated as separable). See `docs/PHYSICS.md` §3.
+    /// The first version whose Cycles uses the height-correlated masking: Cycles commit
+    /// ef22429288cb ("Switch microfacet code to non-separable shadowing-masking term",
+    /// January 2023) is in v3.5.0 and not in v3.4 (`docs/PHYSICS.md` §3).
+    pub const HEIGHT_CORRELATED_FROM: BlenderVersion = BlenderVersion { major: 3, minor: 5 };
+
+    /// The masking–shadowing form Cycles uses in this version: the separable
+    /// `G1(ωi) G1(ωo)` before 3.5, the height-correlated `1/(1 + Λi + Λo)` from 3.5 on.
     pub fn masking(self) -> Masking {
-        if self >= (BlenderVersion { major: 3, minor: 6 }) {
+        if self >= Self::HEIGHT_CORRELATED_FROM {
             Masking::HeightCorrelated
         } else {
             Masking::Separable
@@ -84,6 +85,10 @@ mod tests {
         let v: BlenderVersion = "3.4.1".parse().unwrap();
         assert_eq!(v, BlenderVersion { major: 3, minor: 4 });
         assert_eq!(v.masking(), Masking::Separable);
+        assert_eq!(
+            "3.5.1".parse::<BlenderVersion>().unwrap().masking(),
+            Masking::HeightCorrelated
+        );
         assert_eq!(
             "4.5".parse::<BlenderVersion>().unwrap().masking(),
             Masking::HeightCorrelated

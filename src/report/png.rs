@@ -250,15 +250,15 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             (
                 d,
                 [
-                    pts(|r| r.uncorrected.mean),
+                    pts(|r| r.uncorrected_brightness),
                     pts(|r| r.predicted_uncorrected),
-                    pts(|r| r.corrected.mean),
+                    pts(|r| r.brightness),
                     pts(|r| r.predicted_corrected),
                 ],
             )
         })
         .collect();
-    let reference = percent_points(report.reference.iter().map(|s| (s.roughness, s.stats.mean)));
+    let reference = percent_points(report.reference.iter().map(|s| (s.roughness, s.brightness)));
 
     let tolerance = if report.tolerance_percent.is_finite() {
         report.tolerance_percent.abs()

@@ -2,17 +2,28 @@
 
 use std::fmt::Write as _;
 
-use crate::generate::Mode;
+use crate::generate::{ColorModel, Mode};
 use crate::verify::VerifyReport;
 
 /// The verdict as a terminal table: a title line, one row per sphere, the references,
 /// the verdict line, notes, and the log and rerun command when something failed.
 pub fn render(report: &VerifyReport) -> String {
     let i = &report.render;
+    let white = report.color == [1.0; 3];
+    let colour = if white && report.color_model == ColorModel::Exact {
+        String::new()
+    } else {
+        let rgb: Vec<String> = report.color.iter().map(|c| c.to_string()).collect();
+        format!(
+            " · colour {} ({} colour model; percentages are of what it promises)",
+            rgb.join(","),
+            report.color_model.key()
+        )
+    };
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "Blender {} ({} masking) · coefficients {} · {} px per sphere, {} spp, seed {} · rendered in {:.1} s",
+        "Blender {} ({} masking) · coefficients {} · {} px per sphere, {} spp, seed {} · rendered in {:.1} s{colour}",
         i.blender_version,
         i.masking,
         report.coefficients,
@@ -21,6 +32,7 @@ pub fn render(report: &VerifyReport) -> String {
         i.seed,
         i.render_seconds
     );
+    let average = |v: [f64; 3]| v.iter().sum::<f64>() / 3.0;
     let _ = writeln!(
         s,
         "{:<18} {:>5} {:>12} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
@@ -32,11 +44,11 @@ pub fn render(report: &VerifyReport) -> String {
             "{:<18} {:>5} {:>11.2}% {:>10.2}% {:>6.2}% {:>9.2}% {:>6.1}% {:>7.2}%  {}",
             r.distribution.label(),
             r.roughness,
-            100.0 * r.uncorrected.mean,
-            100.0 * r.corrected.mean,
-            100.0 * r.corrected.standard_error,
+            100.0 * r.uncorrected_brightness,
+            100.0 * r.brightness,
+            100.0 * r.corrected.standard_error / average(r.target),
             100.0 * r.predicted_corrected,
-            100.0 * r.corrected.center,
+            100.0 * r.corrected.center / average(r.target),
             100.0 * r.worst_ring,
             if r.pass { "ok" } else { "FAIL" }
         );
@@ -47,11 +59,11 @@ pub fn render(report: &VerifyReport) -> String {
             "{:<18} {:>5} {:>11.2}% {:>10} {:>6.2}% {:>10} {:>6.1}%  reference",
             "Multiscatter GGX",
             r.roughness,
-            100.0 * r.stats.mean,
+            100.0 * r.brightness,
             "",
-            100.0 * r.stats.standard_error,
+            100.0 * r.stats.standard_error / average(report.color),
             "",
-            100.0 * r.stats.center
+            100.0 * r.stats.center / average(report.color)
         );
     }
     let failed = report.rows.iter().filter(|r| !r.pass).count();

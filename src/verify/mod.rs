@@ -15,7 +15,7 @@ pub use verdict::{Judging, ReferenceSphere, Row, Sweep, VerifyReport};
 use crate::Error;
 use crate::blender::{Blender, BlenderOptions};
 use crate::fit::Coefficients;
-use crate::generate::{GenerateParams, Mode};
+use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Roughness};
 use crate::progress::Progress;
 
@@ -30,6 +30,10 @@ pub struct VerifyOptions {
     pub roughness: Vec<Roughness>,
     pub render: RenderSettings,
     pub mode: Mode,
+    /// The spheres' colour (linear RGB, each in [0, 1]).
+    pub color: [f64; 3],
+    /// What the corrections promise for a colour.
+    pub color_model: ColorModel,
     pub judging: Judging,
     pub blender: BlenderOptions,
 }
@@ -47,6 +51,8 @@ impl Default for VerifyOptions {
             roughness: default_roughness(),
             render: RenderSettings::default(),
             mode: Mode::Roughness,
+            color: [1.0; 3],
+            color_model: ColorModel::Exact,
             judging: Judging::default(),
             blender: BlenderOptions::default(),
         }
@@ -63,6 +69,7 @@ pub struct Verification {
 /// is looked for.
 pub fn verify(v: &VerifyOptions, progress: &dyn Progress) -> Result<Verification, Error> {
     check_roughness(&v.roughness)?;
+    check_color(v.color)?;
     if let Some(name) = &v.coefficients {
         distributions_of(v, &Coefficients::load(name)?, name)?;
     }
@@ -82,20 +89,49 @@ pub fn verify_with(
     let distributions = distributions_of(v, &coefficients, &source)?;
     let roughness: Vec<f64> = v.roughness.iter().map(|r| r.get()).collect();
     let plan = Plan::verify(&distributions, &roughness, v.render);
-    let mut groups = GenerateParams::new(&coefficients, &source);
-    if v.mode != Mode::Roughness {
-        groups = groups.with_view(blender.version.masking());
-    }
-    let rendered = render(blender, &plan, &groups, v.mode, v.blender.timeout, progress)?;
+    let curves = Curves::Pinned {
+        coefficients: &coefficients,
+        name: &source,
+    };
+    let groups = GenerateParams::new(
+        curves,
+        &[blender.version.masking()],
+        &[v.mode],
+        v.color_model,
+    )?;
+    let rendered = render(
+        blender,
+        &plan,
+        &groups,
+        v.mode,
+        v.color,
+        v.blender.timeout,
+        progress,
+    )?;
     let sweep = Sweep {
         coefficients: &coefficients,
         source: &source,
         distributions: &distributions,
         roughness: &roughness,
         mode: v.mode,
+        color: v.color,
+        color_model: v.color_model,
     };
     let report = verdict::judge(&rendered, &sweep, v.judging, blender.version)?;
     Ok(Verification { report, rendered })
+}
+
+/// A colour every channel of which is finite and in [0, 1].
+pub fn check_color(color: [f64; 3]) -> Result<(), Error> {
+    if color.iter().all(|c| (0.0..=1.0).contains(c)) {
+        return Ok(());
+    }
+    let text: Vec<String> = color.iter().map(|c| c.to_string()).collect();
+    Err(Error::input(
+        "--color",
+        &text.join(","),
+        "three linear values from 0 to 1, e.g. 0.95,0.64,0.54",
+    ))
 }
 
 fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {

@@ -110,8 +110,14 @@ impl Plan {
     }
 
     /// The parameter document for `furnace_main.py` (the groups plus the furnace section).
-    /// Corrected spheres use the shader group of `mode`.
-    pub fn params(&self, groups: &GenerateParams, mode: Mode, output: &Path) -> FurnaceParams {
+    /// Corrected spheres use the shader group of `mode`; every sphere is of colour `color`.
+    pub fn params(
+        &self,
+        groups: &GenerateParams,
+        mode: Mode,
+        color: [f64; 3],
+        output: &Path,
+    ) -> FurnaceParams {
         let shader_of = |d: Distribution| -> String {
             groups
                 .groups
@@ -147,6 +153,7 @@ impl Plan {
                 samples: self.settings.samples,
                 seed: self.settings.seed,
                 radius_fraction: self.settings.radius_fraction,
+                color,
                 output: output.to_string_lossy().into_owned(),
                 threads: 0,
                 spheres,
@@ -175,6 +182,8 @@ pub struct FurnaceSection {
     pub samples: u32,
     pub seed: u32,
     pub radius_fraction: f64,
+    /// Every sphere's colour (linear RGB).
+    pub color: [f64; 3],
     pub output: String,
     pub threads: u32,
     pub spheres: Vec<SphereSpec>,

@@ -39,18 +39,20 @@ pub struct Rendered {
     pub plan: Plan,
 }
 
-/// Renders `plan` in one Blender process; `progress` follows the samples Cycles logs.
+/// Renders `plan` in one Blender process, every sphere of colour `color`; `progress`
+/// follows the samples Cycles logs.
 pub fn render(
     blender: &Blender,
     plan: &Plan,
     groups: &GenerateParams,
     mode: Mode,
+    color: [f64; 3],
     timeout: Duration,
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     let run_dir = runs::new_run_dir("verify")?;
     let exr = run_dir.join("sweep.exr");
-    let params = plan.params(groups, mode, &exr);
+    let params = plan.params(groups, mode, color, &exr);
     let script = run_dir.join("gloffuse-furnace.py");
     write_atomic(&script, assemble(&params, Job::Furnace).as_bytes())?;
     let log = run_dir.join("blender.log");

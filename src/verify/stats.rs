@@ -18,12 +18,16 @@ pub struct Ring {
     pub pixels: usize,
     /// Mean brightness (0–1) of the ring's fully covered pixels; NaN if it holds none.
     pub mean: f64,
+    /// The same per channel (R, G, B).
+    pub mean_rgb: [f64; 3],
 }
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SphereStats {
     /// Σ RGB / (3 Σ alpha) over the cell: the sphere's mean brightness (0–1).
     pub mean: f64,
+    /// Σ R / Σ alpha, Σ G / Σ alpha, Σ B / Σ alpha: the mean per channel.
+    pub mean_rgb: [f64; 3],
     /// Estimated standard error of `mean` (from the pixel spread within each ring).
     pub standard_error: f64,
     /// Mean of the pixels with μ ≥ 0.995 (within 10 % of the radius of the centre).
@@ -46,8 +50,10 @@ pub fn sphere_stats(
     let centre = cell as f64 / 2.0;
     let radius = radius_fraction * cell as f64 / 2.0;
     let (mut sum_rgb, mut sum_a) = (0.0f64, 0.0f64);
+    let mut sum_channel = [0.0f64; 3];
     let (mut centre_sum, mut centre_n) = (0.0f64, 0usize);
     let mut ring_sum = [0.0f64; RINGS];
+    let mut ring_channel = [[0.0f64; 3]; RINGS];
     let mut ring_sq = [0.0f64; RINGS];
     let mut ring_n = [0usize; RINGS];
     for y in y0..(y0 + cell).min(img.height) {
@@ -56,6 +62,9 @@ pub fn sphere_stats(
             let rgb = (p[0] as f64 + p[1] as f64 + p[2] as f64) / 3.0;
             sum_rgb += rgb;
             sum_a += p[3] as f64;
+            for (c, sum) in sum_channel.iter_mut().enumerate() {
+                *sum += p[c] as f64;
+            }
             let dx = (x - x0) as f64 + 0.5 - centre;
             let dy = (y - y0) as f64 + 0.5 - centre;
             let d = (dx * dx + dy * dy).sqrt() / radius;
@@ -67,6 +76,9 @@ pub fn sphere_stats(
                 ring_sum[k] += v;
                 ring_sq[k] += v * v;
                 ring_n[k] += 1;
+                for (c, sum) in ring_channel[k].iter_mut().enumerate() {
+                    *sum += p[c] as f64 / p[3] as f64;
+                }
                 if d <= 0.1 {
                     centre_sum += v;
                     centre_n += 1;
@@ -100,6 +112,7 @@ pub fn sphere_stats(
                 mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64),
                 pixels: n,
                 mean: m,
+                mean_rgb: ring_channel[k].map(|sum| sum / n as f64),
             }
         })
         .collect();
@@ -110,6 +123,7 @@ pub fn sphere_stats(
     };
     SphereStats {
         mean,
+        mean_rgb: sum_channel.map(|sum| sum / sum_a),
         standard_error,
         center: if centre_n > 0 {
             centre_sum / centre_n as f64

@@ -8,7 +8,7 @@ use super::render::{RenderInfo, Rendered};
 use super::stats::SphereStats;
 use crate::Error;
 use crate::fit::{Coefficients, ColorSpace, preset_for};
-use crate::generate::Mode;
+use crate::generate::{ColorModel, Mode};
 use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Glossy, Roughness};
 
 /// Rings with fewer fully covered pixels than this are too noisy to judge flatness by (at
@@ -44,14 +44,24 @@ pub struct Row {
     pub roughness: f64,
     pub uncorrected: SphereStats,
     pub corrected: SphereStats,
+    /// What the colour model promises the corrected sphere's mean is, per channel: the
+    /// colour itself (exact), or the colour with multiple bounces tinted (physical).
+    pub target: [f64; 3],
+    /// The uncorrected sphere's mean relative to the colour (1 for a white sphere that lost
+    /// nothing), the channels averaged.
+    pub uncorrected_brightness: f64,
+    /// The corrected sphere's mean relative to `target`, the channels averaged: 1 is right.
+    pub brightness: f64,
     /// The integrator's E_avg(r) for this Blender's masking (0–1).
     pub predicted_uncorrected: f64,
-    /// gain(r) · E_avg(r): what the coefficients should give (0–1).
+    /// What the coefficients should give relative to `target` (gain(r) · E_avg(r) for a
+    /// white sphere; 1 in the view modes).
     pub predicted_corrected: f64,
-    /// Largest |ring mean − 1| of the corrected sphere over its view-cosine rings.
+    /// Largest |ring mean / ring target − 1| of the corrected sphere over its view-cosine
+    /// rings and channels.
     pub worst_ring: f64,
-    /// |corrected mean − 1| ≤ tolerance (and, in the view modes, every ring within the ring
-    /// tolerance).
+    /// Every channel's |mean / target − 1| ≤ tolerance (and, in the view modes, every ring
+    /// within the ring tolerance).
     pub pass: bool,
 }
 
@@ -60,12 +70,17 @@ pub struct Row {
 pub struct ReferenceSphere {
     pub roughness: f64,
     pub stats: SphereStats,
+    /// Its mean relative to what the colour model promises a GGX sphere, channels averaged.
+    pub brightness: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
 pub struct VerifyReport {
     pub coefficients: String,
     pub mode: Mode,
+    /// The spheres' colour, and what the corrections promise for it.
+    pub color: [f64; 3],
+    pub color_model: ColorModel,
     /// Allowed |ring mean − 100 %| in the view modes, in percent.
     pub ring_tolerance_percent: f64,
     pub render: RenderInfo,
@@ -78,12 +93,13 @@ pub struct VerifyReport {
     pub pass: bool,
 }
 
-/// The largest |ring mean − 100 %| over the view-cosine rings of a sphere.
-fn worst_ring(s: &SphereStats) -> f64 {
+/// The largest |ring mean / its target − 1| over the view-cosine rings (with at least
+/// [`MIN_RING_PIXELS`] pixels) and channels of a sphere.
+fn worst_ring(s: &SphereStats, target: impl Fn((f64, f64)) -> [f64; 3]) -> f64 {
     s.rings
         .iter()
         .filter(|r| r.pixels >= MIN_RING_PIXELS)
-        .map(|r| (r.mean - 1.0).abs())
+        .map(|r| relative(r.mean_rgb, target(r.mu)).1)
         .fold(0.0, f64::max)
 }
 
@@ -95,6 +111,53 @@ pub struct Sweep<'a> {
     pub distributions: &'a [Distribution],
     pub roughness: &'a [f64],
     pub mode: Mode,
+    /// The spheres' colour and what a correction promises for it.
+    pub color: [f64; 3],
+    pub color_model: ColorModel,
+}
+
+/// Kulla and Conty's tint of the energy multiple bounces add, per channel:
+/// `Fms = C E_avg / (1 − C (1 − E_avg))` (Cycles' Multiscatter GGX uses the same).
+fn tinted_energy(color: [f64; 3], e_avg: f64) -> [f64; 3] {
+    color.map(|c| c * e_avg / (1.0 - c * (1.0 - e_avg)))
+}
+
+/// What a correction promises a surface whose (mean) directional albedo is `e`, of a
+/// distribution and roughness with hemispherical albedo `e_avg`: `C` (exact), or
+/// `C (E + Fms (1 − E))` (physical).
+fn target(model: ColorModel, color: [f64; 3], e_avg: f64, e: f64) -> [f64; 3] {
+    match model {
+        ColorModel::Exact => color,
+        ColorModel::Physical => {
+            let fms = tinted_energy(color, e_avg);
+            [0, 1, 2].map(|c| color[c] * (e + fms[c] * (1.0 - e)))
+        }
+    }
+}
+
+/// `measured / target` per channel, averaged; and the worst channel's |ratio − 1|.
+fn relative(measured: [f64; 3], target: [f64; 3]) -> (f64, f64) {
+    let ratios = [0, 1, 2].map(|c| measured[c] / target[c]);
+    let worst = ratios.iter().map(|q| (q - 1.0).abs()).fold(0.0, f64::max);
+    (ratios.iter().sum::<f64>() / 3.0, worst)
+}
+
+/// The mean of E over a view-cosine ring [lo, hi) of an orthographic sphere, whose pixels
+/// have view-cosine density ∝ μ: `∫ E μ dμ / ∫ μ dμ` by 4-point Gauss–Legendre.
+fn ring_albedo(integrator: &AlbedoIntegrator, glossy: &Glossy, (lo, hi): (f64, f64)) -> f64 {
+    const NODES: [(f64, f64); 4] = [
+        (0.069_431_844_202_973_7, 0.173_927_422_568_726_9),
+        (0.330_009_478_207_571_9, 0.326_072_577_431_273_1),
+        (0.669_990_521_792_428_1, 0.326_072_577_431_273_1),
+        (0.930_568_155_797_026_3, 0.173_927_422_568_726_9),
+    ];
+    let (mut num, mut den) = (0.0, 0.0);
+    for (x, w) in NODES {
+        let mu = lo + (hi - lo) * x;
+        num += w * mu * integrator.directional_albedo(glossy, mu.max(1e-4));
+        den += w * mu;
+    }
+    num / den
 }
 
 /// Judges a rendered verify sweep: every corrected sphere against 100 % (and, in the view
@@ -112,6 +175,8 @@ pub fn judge(
         distributions,
         roughness,
         mode,
+        color,
+        color_model,
     } = *sweep;
     let plan = &rendered.plan;
     let masking = version.masking();
@@ -128,21 +193,38 @@ pub fn judge(
     for &d in distributions {
         let curve = &coefficients.distributions[&d].curve;
         for &r in roughness {
-            let e_avg = integrator.average_albedo(&Glossy::new(d, masking, Roughness::new(r)?));
+            let glossy = Glossy::new(d, masking, Roughness::new(r)?);
+            let e_avg = integrator.average_albedo(&glossy);
+            let target = target(color_model, color, e_avg, e_avg);
             let corrected = find(Role::Corrected(d), r);
-            let worst_ring = worst_ring(&corrected);
+            let uncorrected = find(Role::Uncorrected(d), r);
+            let (brightness, deviation) = relative(corrected.mean_rgb, target);
+            // Every pixel's target: shown in every mode, judged in the view modes.
+            let worst_ring = worst_ring(&corrected, |mu| {
+                let e = ring_albedo(&integrator, &glossy, mu);
+                self::target(color_model, color, e_avg, e)
+            });
             let rings_flat =
                 mode == Mode::Roughness || worst_ring <= judging.ring_tolerance_percent / 100.0;
+            // What the roughness-only gain g gives: C g E_avg (exact), or
+            // C E_avg / (1 − C (1 − 1/g)) (physical).
+            let achieved = |c: f64| match color_model {
+                ColorModel::Exact => c * curve.gain(r) * e_avg,
+                ColorModel::Physical => c * e_avg / (1.0 - c * (1.0 - 1.0 / curve.gain(r))),
+            };
             rows.push(Row {
                 distribution: d,
                 roughness: r,
-                uncorrected: find(Role::Uncorrected(d), r),
-                pass: (corrected.mean - 1.0).abs() <= tolerance && rings_flat,
+                uncorrected_brightness: relative(uncorrected.mean_rgb, color).0,
+                uncorrected,
+                pass: deviation <= tolerance && rings_flat,
                 worst_ring,
+                brightness,
+                target,
                 corrected,
                 predicted_uncorrected: e_avg,
                 predicted_corrected: match mode {
-                    Mode::Roughness => curve.gain(r) * e_avg,
+                    Mode::Roughness => relative(color.map(achieved), target).0,
                     Mode::View | Mode::Multiscatter => 1.0,
                 },
             });
@@ -150,11 +232,17 @@ pub fn judge(
     }
     let reference = roughness
         .iter()
-        .map(|&r| ReferenceSphere {
-            roughness: r,
-            stats: find(Role::Reference, r),
+        .map(|&r| {
+            let ggx = Glossy::new(Distribution::Ggx, masking, Roughness::new(r)?);
+            let e_avg = integrator.average_albedo(&ggx);
+            let stats = find(Role::Reference, r);
+            Ok(ReferenceSphere {
+                roughness: r,
+                brightness: relative(stats.mean_rgb, target(color_model, color, e_avg, e_avg)).0,
+                stats,
+            })
         })
-        .collect();
+        .collect::<Result<_, Error>>()?;
     let pass = rows.iter().all(|r| r.pass);
     let mut notes = Vec::new();
     for (d, e) in &coefficients.distributions {
@@ -176,9 +264,9 @@ pub fn judge(
         .any(|e| e.color_space == ColorSpace::Display)
     {
         let worst = rows.iter().filter(|r| !r.pass).max_by(|a, b| {
-            (a.corrected.mean - 1.0)
+            (a.brightness - 1.0)
                 .abs()
-                .total_cmp(&(b.corrected.mean - 1.0).abs())
+                .total_cmp(&(b.brightness - 1.0).abs())
         });
         let mut note = format!(
             "The coefficients '{source}' are display-referred: their percentages are sRGB-encoded brightness read off a screen (sRGB(0.305) ≈ 0.59 is GGX's centre at r = 1), but a shader gain acts on linear light, so 100/f(r) under-corrects rough spheres."
@@ -188,7 +276,7 @@ pub fn judge(
                 " Worst: {} r = {} comes out at {:.1} % (gain {:.3}; 1/E_avg = {:.3} is needed).",
                 w.distribution.label(),
                 w.roughness,
-                100.0 * w.corrected.mean,
+                100.0 * w.brightness,
                 coefficients.distributions[&w.distribution]
                     .curve
                     .gain(w.roughness),
@@ -200,6 +288,8 @@ pub fn judge(
     Ok(VerifyReport {
         coefficients: source.to_string(),
         mode,
+        color,
+        color_model,
         ring_tolerance_percent: judging.ring_tolerance_percent,
         render: rendered.info.clone(),
         tolerance_percent: judging.tolerance_percent,

@@ -1,0 +1,314 @@
+# ---------------------------------------------------------------------------
+# gloffuse furnace.py: the white furnace the verify and refresh jobs render.
+#
+# A white world of strength 1, an orthographic camera looking down -Z at a grid
+# of white spheres (one cell per sphere, row 0 at the top of the image), each
+# sphere visible to camera rays only so that it sees nothing but the world.
+# One Cycles render of the whole grid is written as a single-layer, 32-bit
+# float, ZIP-compressed OpenEXR (scene-linear RGBA, premultiplied by coverage
+# because the film is transparent). The "furnace" section of the parameter
+# document says what to render (furnace_params checks it).
+#
+# A part of the scripts that render: the binary concatenates the header,
+# compat.py, params.py, nodes.py, roughness_groups.py, normal_group.py,
+# view_groups.py, groups.py, runtime.py, furnace.py, then furnace_main.py.
+# Functions and constants only; every Blender version difference in the scene
+# goes through compat.py's compat_* functions.
+# ---------------------------------------------------------------------------
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import bpy
+import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
+
+FURNACE_PLAIN_DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY", "MULTI_GGX")
+
+# Each sphere is the upper half (plus one ring) of a UV sphere with this many
+# segments and rings (counted on the full sphere). The sphere's mean converges
+# to E_avg as 1/rings^2, driven by the radial resolution near the silhouette:
+# measured in 4.5 (1024 spp), the GGX/Ashikhmin-Shirley r=1 means come out
+# +0.07 % high with 64 rings and within 0.01-0.02 % of a 512 x 256 sphere with
+# 128 x 128, at the triangle count of a full 128 x 64 sphere.
+FURNACE_SPHERE_SEGMENTS = 128
+FURNACE_SPHERE_RINGS = 128
+
+# One world unit per grid cell; the camera sits well above the spheres.
+FURNACE_CAMERA_HEIGHT = 10.0
+
+
+class FurnaceParamsError(ValueError):
+    """The parameter document's "furnace" section is missing or malformed."""
+
+
+# --- arguments and parameters ------------------------------------------------
+
+def parse_furnace_args(args):
+    parser = argparse.ArgumentParser(
+        prog="gloffuse-furnace",
+        description="Render the gloffuse furnace grid described by the embedded parameters.")
+    parser.add_argument("--output", metavar="OUT.exr",
+                        help="write the EXR here instead of furnace.output")
+    return parser.parse_args(args)
+
+
+def furnace_require(cond, message):
+    if not cond:
+        raise FurnaceParamsError("furnace parameters: " + message)
+
+
+def furnace_number(section, key, kind, low, high=None):
+    value = section.get(key)
+    furnace_require(isinstance(value, (int, float)) and not isinstance(value, bool),
+                    "%r must be a number, got %r" % (key, value))
+    furnace_require(kind is float or float(value).is_integer(),
+                    "%r must be an integer, got %r" % (key, value))
+    value = kind(value)
+    furnace_require(value >= low and (high is None or value <= high),
+                    "%r = %r is outside [%r, %s]"
+                    % (key, value, low, "inf" if high is None else high))
+    return value
+
+
+def furnace_sphere_spec(index, sphere):
+    """Check one sphere entry and return a normalised copy."""
+    where = "spheres[%d]" % index
+    furnace_require(isinstance(sphere, dict), "%s must be an object" % where)
+    roughness = furnace_number(sphere, "roughness", float, 0.0, 1.0)
+    shader = sphere.get("shader")
+    if shader == "plain":
+        distribution = sphere.get("distribution")
+        furnace_require(distribution in FURNACE_PLAIN_DISTRIBUTIONS,
+                        "%s.distribution must be one of %s, got %r"
+                        % (where, ", ".join(FURNACE_PLAIN_DISTRIBUTIONS), distribution))
+        return {"shader": "plain", "distribution": distribution, "roughness": roughness}
+    if shader == "group":
+        group = sphere.get("group")
+        furnace_require(isinstance(group, str) and group != "",
+                        "%s.group must be a node group name" % where)
+        return {"shader": "group", "group": group, "roughness": roughness}
+    raise FurnaceParamsError("furnace parameters: %s.shader must be \"plain\" or \"group\", got %r"
+                             % (where, shader))
+
+
+def furnace_color(section):
+    """The spheres' colour: three numbers in [0, 1] (white when absent)."""
+    color = section.get("color", [1.0, 1.0, 1.0])
+    furnace_require(isinstance(color, list) and len(color) == 3,
+                    "\"color\" must be [r, g, b], got %r" % (color,))
+    return tuple(furnace_number({"color": c}, "color", float, 0.0, 1.0) for c in color)
+
+
+def furnace_params(document):
+    """The validated "furnace" section of the parameter document."""
+    furnace_require(isinstance(document, dict), "the parameter document must be an object")
+    section = document.get("furnace")
+    furnace_require(isinstance(section, dict), "the document has no \"furnace\" object")
+    output = section.get("output")
+    furnace_require(isinstance(output, str) and output != "", "\"output\" must be a file path")
+    spheres = section.get("spheres")
+    furnace_require(isinstance(spheres, list) and spheres, "\"spheres\" must be a non-empty list")
+    return {
+        "cell": furnace_number(section, "cell", int, 4),
+        "columns": furnace_number(section, "columns", int, 1),
+        "samples": furnace_number(section, "samples", int, 1),
+        "seed": furnace_number(section, "seed", int, 0, 2 ** 31 - 1),  # Cycles' seed range
+        "radius_fraction": furnace_number(section, "radius_fraction", float, 0.05, 1.0),
+        "color": furnace_color(section),
+        "threads": furnace_number(section, "threads", int, 0),
+        "output": output,
+        "spheres": [furnace_sphere_spec(i, s) for i, s in enumerate(spheres)],
+    }
+
+
+def furnace_grid(furnace):
+    """(columns, rows) of the grid; row-major, row 0 at the top."""
+    columns = furnace["columns"]
+    rows = (len(furnace["spheres"]) + columns - 1) // columns
+    return columns, rows
+
+
+# --- scene ---------------------------------------------------------------------
+
+def furnace_world():
+    world = bpy.data.worlds.new("Gloffuse furnace world")
+    tree = compat_node_tree(world)  # noqa: F821 -- compat.py
+    tree.nodes.clear()
+    background = tree.nodes.new("ShaderNodeBackground")
+    background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    output = tree.nodes.new("ShaderNodeOutputWorld")
+    tree.links.new(background.outputs["Background"], output.inputs["Surface"])
+    world.color = (1.0, 1.0, 1.0)
+    return world
+
+
+def furnace_sphere_mesh(radius):
+    """One smooth-shaded UV dome shared by every sphere object; its single
+    material slot is linked per object."""
+    mesh = bpy.data.meshes.new("Gloffuse furnace sphere")
+    bm = bmesh.new()
+    compat_uv_sphere(bm, radius, FURNACE_SPHERE_SEGMENTS, FURNACE_SPHERE_RINGS)  # noqa: F821
+    # The camera looks down -Z and no other ray sees a sphere, so only the
+    # upper half is ever hit: drop the rest (render time grows with the
+    # triangle count: Cycles syncs a separate copy of the mesh for every object
+    # here, the per-object materials keeping it from instancing).
+    # One ring below the equator stays so that the equator's smooth normals
+    # stay horizontal.
+    below = -radius * math.sin(math.pi / FURNACE_SPHERE_RINGS) * 1.001
+    bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.z < below], context="VERTS")
+    bm.to_mesh(mesh)
+    bm.free()
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
+    mesh.materials.append(None)
+    mesh.update()
+    return mesh
+
+
+def furnace_group_output(node):
+    if "BSDF" in node.outputs:
+        return node.outputs["BSDF"]
+    for socket in node.outputs:
+        if socket.type == "SHADER":
+            return socket
+    raise RuntimeError("node group %r has no shader output" % node.node_tree.name)
+
+
+def furnace_material(index, sphere, color):
+    """A material of colour `color`: a plain Glossy BSDF of the given
+    distribution, or the named gloffuse shader group."""
+    if sphere["shader"] == "plain":
+        label = "plain %s" % sphere["distribution"]
+    else:
+        label = sphere["group"]
+    material = bpy.data.materials.new("Furnace %03d %s r=%g" % (index, label, sphere["roughness"]))
+    tree = compat_node_tree(material)  # noqa: F821 -- compat.py
+    tree.nodes.clear()
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    output.target = "ALL"
+    if sphere["shader"] == "plain":
+        node = tree.nodes.new("ShaderNodeBsdfGlossy")
+        node.distribution = sphere["distribution"]
+        shader_output = node.outputs["BSDF"]
+    else:
+        group = bpy.data.node_groups.get(sphere["group"])
+        if group is None:
+            raise FurnaceParamsError("furnace parameters: sphere %d uses node group %r, which "
+                                     "was not built (groups: %s)"
+                                     % (index, sphere["group"],
+                                        ", ".join(repr(g.name) for g in bpy.data.node_groups)))
+        node = tree.nodes.new("ShaderNodeGroup")
+        node.node_tree = group
+        shader_output = furnace_group_output(node)
+    node.inputs["Color"].default_value = tuple(color) + (1.0,)
+    node.inputs["Roughness"].default_value = sphere["roughness"]
+    tree.links.new(shader_output, output.inputs["Surface"])
+    return material
+
+
+def furnace_camera(columns):
+    data = bpy.data.cameras.new("Gloffuse furnace camera")
+    data.type = "ORTHO"
+    data.sensor_fit = "HORIZONTAL"
+    data.ortho_scale = float(columns)  # one world unit per cell
+    data.shift_x = 0.0
+    data.shift_y = 0.0
+    data.clip_start = 0.1
+    data.clip_end = 2.0 * FURNACE_CAMERA_HEIGHT
+    camera = bpy.data.objects.new("Gloffuse furnace camera", data)
+    camera.location = (0.0, 0.0, FURNACE_CAMERA_HEIGHT)
+    camera.rotation_euler = (0.0, 0.0, 0.0)  # looks down -Z, +Y up in the image
+    return camera
+
+
+def furnace_render_settings(scene, furnace, columns, rows):
+    render = scene.render
+    render.engine = "CYCLES"
+    render.resolution_x = columns * furnace["cell"]
+    render.resolution_y = rows * furnace["cell"]
+    render.resolution_percentage = 100
+    render.pixel_aspect_x = 1.0
+    render.pixel_aspect_y = 1.0
+    render.use_border = False
+    render.film_transparent = True
+    compat_disable_post_processing(render)  # noqa: F821 -- compat.py
+    if furnace["threads"] > 0:
+        render.threads_mode = "FIXED"
+        render.threads = furnace["threads"]
+    else:
+        render.threads_mode = "AUTO"
+
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = furnace["samples"]
+    cycles.seed = furnace["seed"]
+    cycles.use_animated_seed = False
+    cycles.use_adaptive_sampling = False
+    compat_disable_time_limit(cycles)  # noqa: F821 -- compat.py
+    # Clamping would bias the estimate; 0 disables it.
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
+
+    view = scene.view_settings
+    scene.display_settings.display_device = "sRGB"
+    view.view_transform = "Standard"
+    view.look = "None"
+    view.exposure = 0.0
+    view.gamma = 1.0
+    view.use_curve_mapping = False
+    compat_exr_settings(render.image_settings)  # noqa: F821 -- compat.py
+
+
+def furnace_scene(furnace):
+    """Build the furnace grid in the current (empty) scene and return it."""
+    scene = bpy.context.scene
+    columns, rows = furnace_grid(furnace)
+    furnace_render_settings(scene, furnace, columns, rows)
+    scene.world = furnace_world()
+
+    camera = furnace_camera(columns)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+
+    mesh = furnace_sphere_mesh(0.5 * furnace["radius_fraction"])
+    for index, sphere in enumerate(furnace["spheres"]):
+        column, row = index % columns, index // columns
+        obj = bpy.data.objects.new("Furnace sphere %03d" % index, mesh)
+        obj.location = (column + 0.5 - 0.5 * columns, 0.5 * rows - row - 0.5, 0.0)
+        scene.collection.objects.link(obj)
+        slot = obj.material_slots[0]
+        slot.link = "OBJECT"
+        slot.material = furnace_material(index, sphere, furnace["color"])
+        compat_camera_rays_only(obj)  # noqa: F821 -- compat.py
+    return scene
+
+
+def render_result_image():
+    for image in bpy.data.images:
+        if image.type == "RENDER_RESULT":
+            return image
+    raise RuntimeError("rendering produced no Render Result image")
+
+
+def render_sweep(output):
+    """Render the current scene once and save it to `output`; returns render seconds."""
+    directory = os.path.dirname(output)
+    if directory:
+        os.makedirs(directory, exist_ok=True)
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=False)
+    seconds = time.perf_counter() - start
+    # save_render writes the scene's image settings; for OpenEXR that is the
+    # scene-linear result whatever the view transform.
+    # (No scene= argument: in 3.4 passing it leaks an image-format copy and
+    # prints "Error: Not freed memory blocks" at exit.)
+    render_result_image().save_render(filepath=output)
+    if not os.path.isfile(output):
+        raise RuntimeError("Blender did not write %s" % output)
+    return seconds

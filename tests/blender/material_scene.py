@@ -1,0 +1,197 @@
+# ---------------------------------------------------------------------------
+# material_scene.py: the main of the tests' "real material" scene, appended by
+# tests/materials_e2e.rs after the library parts and furnace.py (so it builds
+# the groups and the world exactly as gloffuse does).
+#
+# A white furnace, but not a lab sphere: a perspective camera, an off-centre
+# smooth sphere whose normal is tilted by a Noise texture (a procedural normal
+# map) and whose roughness comes from a texture (r0 -> r1 across the object's x). Every
+# variant of the document's "scene" section is rendered on that sphere, one
+# render each, all with the same seed and a point-like pixel filter, so each
+# pixel of every render is shaded at the same point with the same random
+# numbers: the ratio of two renders is the ratio of their BSDF weights there.
+#
+# Variants ("kind"):
+#   glossy      a plain Glossy BSDF of "distribution" (MULTI_GGX included)
+#   group       the shader group "group" (Color, Roughness, Normal inputs)
+#   correction  the correction group "group" feeding a plain Glossy of "distribution"
+#   probe       an emission of 0.5 + 0.5 v for v = the view direction ("incoming"),
+#               the true normal, the tilted normal, or (r, 0, 0) ("roughness")
+# Each render is written to output_dir/NAME.exr; one GLOFFUSE_RESULT line lists them.
+# ---------------------------------------------------------------------------
+import json
+import math
+import os
+import sys
+
+import bpy
+import bmesh
+
+
+def scene_section(document):
+    scene = document.get("scene")
+    if not isinstance(scene, dict) or not scene.get("variants"):
+        raise ValueError("the document needs a 'scene' section with variants")
+    return scene
+
+
+def shading_inputs(tree, scene):
+    """The roughness texture and the bumped normal every variant shares."""
+    nodes, links = tree.nodes, tree.links
+    coords = nodes.new("ShaderNodeTexCoord")
+    split = nodes.new("ShaderNodeSeparateXYZ")
+    links.new(coords.outputs["Object"], split.inputs[0])
+    r0, r1 = scene["roughness"]
+    ramp = nodes.new("ShaderNodeMapRange")
+    ramp.inputs["From Min"].default_value = -1.0
+    ramp.inputs["From Max"].default_value = 1.0
+    ramp.inputs["To Min"].default_value = r0
+    ramp.inputs["To Max"].default_value = r1
+    ramp.clamp = True
+    links.new(split.outputs["X"], ramp.inputs["Value"])
+    noise = nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = scene["noise_scale"]
+    links.new(coords.outputs["Object"], noise.inputs["Vector"])
+    # A procedural normal map: the smooth normal tilted by the noise colour
+    # (2 c - 1, times "tilt"), so some normals lean far away from the viewer.
+    # (Not a Bump node: Blender 3.0-3.5's Bump node raises its own output, and
+    # 4.x's bumps are gentler, so neither would exercise the BSDF's raise.)
+    signed = nodes.new("ShaderNodeVectorMath")
+    signed.operation = "MULTIPLY_ADD"
+    links.new(noise.outputs["Color"], signed.inputs[0])
+    signed.inputs[1].default_value = (2.0 * scene["tilt"],) * 3
+    signed.inputs[2].default_value = (-scene["tilt"],) * 3
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    tilted = nodes.new("ShaderNodeVectorMath")
+    tilted.operation = "ADD"
+    links.new(geometry.outputs["Normal"], tilted.inputs[0])
+    links.new(signed.outputs["Vector"], tilted.inputs[1])
+    normal = nodes.new("ShaderNodeVectorMath")
+    normal.operation = "NORMALIZE"
+    links.new(tilted.outputs["Vector"], normal.inputs[0])
+    return ramp.outputs["Result"], normal.outputs["Vector"]
+
+
+def encoded(tree, vector):
+    """0.5 + 0.5 v as a colour (emission stays non-negative)."""
+    node = tree.nodes.new("ShaderNodeVectorMath")
+    node.operation = "MULTIPLY_ADD"
+    tree.links.new(vector, node.inputs[0])
+    node.inputs[1].default_value = (0.5, 0.5, 0.5)
+    node.inputs[2].default_value = (0.5, 0.5, 0.5)
+    return node.outputs["Vector"]
+
+
+def variant_material(scene, variant):
+    material = bpy.data.materials.new("Scene %s" % variant["name"])
+    tree = compat_node_tree(material)  # noqa: F821 -- compat.py
+    tree.nodes.clear()
+    nodes, links = tree.nodes, tree.links
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.target = "ALL"
+    roughness, normal = shading_inputs(tree, scene)
+    color = tuple(variant.get("color", (1.0, 1.0, 1.0))) + (1.0,)
+    kind = variant["kind"]
+    if kind == "probe":
+        geometry = nodes.new("ShaderNodeNewGeometry")
+        probe = variant["probe"]
+        if probe == "roughness":
+            combine = nodes.new("ShaderNodeCombineXYZ")
+            links.new(roughness, combine.inputs["X"])
+            value = combine.outputs[0]
+        else:
+            value = {"incoming": geometry.outputs["Incoming"],
+                     "true_normal": geometry.outputs["True Normal"],
+                     "normal": normal}[probe]
+        emission = nodes.new("ShaderNodeEmission")
+        emission.inputs["Strength"].default_value = 1.0
+        links.new(encoded(tree, value), emission.inputs["Color"])
+        shader = emission.outputs[0]
+    elif kind == "glossy":
+        glossy = nodes.new("ShaderNodeBsdfGlossy")
+        glossy.distribution = variant["distribution"]
+        glossy.inputs["Color"].default_value = color
+        links.new(roughness, glossy.inputs["Roughness"])
+        links.new(normal, glossy.inputs["Normal"])
+        shader = glossy.outputs[0]
+    elif kind == "group":
+        node = nodes.new("ShaderNodeGroup")
+        node.node_tree = bpy.data.node_groups[variant["group"]]
+        node.inputs["Color"].default_value = color
+        links.new(roughness, node.inputs["Roughness"])
+        links.new(normal, node.inputs["Normal"])
+        shader = node.outputs["BSDF"]
+    elif kind == "correction":
+        node = nodes.new("ShaderNodeGroup")
+        node.node_tree = bpy.data.node_groups[variant["group"]]
+        node.inputs["Color"].default_value = color
+        links.new(roughness, node.inputs["Roughness"])
+        links.new(normal, node.inputs["Normal"])
+        glossy = nodes.new("ShaderNodeBsdfGlossy")
+        glossy.distribution = variant["distribution"]
+        links.new(node.outputs["Color"], glossy.inputs["Color"])
+        links.new(roughness, glossy.inputs["Roughness"])
+        links.new(normal, glossy.inputs["Normal"])
+        shader = glossy.outputs[0]
+    else:
+        raise ValueError("variant %r: unknown kind %r" % (variant["name"], kind))
+    links.new(shader, output.inputs["Surface"])
+    return material
+
+
+def build_scene(scene):
+    render_scene = bpy.context.scene
+    size = scene["resolution"]
+    settings = {"cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
+    furnace_render_settings(render_scene, settings, 1, 1)  # noqa: F821 -- furnace.py
+    # A point-like pixel filter: every sample of a pixel hits the same point.
+    render_scene.cycles.filter_width = 0.01
+    render_scene.world = furnace_world()  # noqa: F821 -- furnace.py
+
+    data = bpy.data.cameras.new("Scene camera")
+    data.lens = 50.0
+    camera = bpy.data.objects.new("Scene camera", data)
+    camera.location = (0.0, -5.0, 0.6)
+    camera.rotation_euler = (math.radians(83.0), 0.0, 0.0)
+    render_scene.collection.objects.link(camera)
+    render_scene.camera = camera
+
+    mesh = bpy.data.meshes.new("Scene sphere")
+    bm = bmesh.new()
+    compat_uv_sphere(bm, 1.0, 96, 48)  # noqa: F821 -- compat.py
+    bm.to_mesh(mesh)
+    bm.free()
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
+    mesh.materials.append(None)
+    sphere = bpy.data.objects.new("Scene sphere", mesh)
+    sphere.location = (0.45, 0.0, 0.25)
+    render_scene.collection.objects.link(sphere)
+    compat_camera_rays_only(sphere)  # noqa: F821 -- compat.py
+    return render_scene, sphere
+
+
+def scene_main():
+    document = json.loads(GLOFFUSE_PARAMS)  # noqa: F821 -- the generated header
+    scene = scene_section(document)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    build_all(resolve_params(document))  # noqa: F821 -- groups.py, params.py
+    render_scene, sphere = build_scene(scene)
+    written = []
+    for variant in scene["variants"]:
+        sphere.data.materials[0] = variant_material(scene, variant)
+        probe = variant["kind"] == "probe"
+        render_scene.cycles.samples = scene["probe_samples"] if probe else scene["samples"]
+        path = os.path.join(scene["output_dir"], variant["name"] + ".exr")
+        render_sweep(path)  # noqa: F821 -- furnace.py
+        written.append(path)
+    print(result_line({  # noqa: F821 -- runtime.py
+        "blender_version": blender_version_string(),  # noqa: F821 -- compat.py
+        "written": written,
+    }))
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    run_main(scene_main)  # noqa: F821 -- runtime.py
