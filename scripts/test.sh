@@ -2,6 +2,7 @@
 # The whole test suite, against real Blender: installs what is missing, then runs cargo test.
 #   Blender 3.4 — Debian's `blender` package (a real binary)
 #   Blender 4.5 LTS and 5.0 — PyPI's `bpy` (Blender as a Python module, CPython 3.11)
+#   Chromium — Debian's `chromium`, to load and screenshot the HTML report
 # Idempotent: a second run reuses what the first installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,11 +10,15 @@ cd "$(dirname "$0")/.."
 cache="${GLOFFUSE_TEST_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/gloffuse/test-blenders}"
 mkdir -p "$cache"
 
-if ! command -v blender >/dev/null 2>&1; then
-    echo "== installing Debian's blender (3.4)"
+# Debian's blender (3.4) and, for the report page's browser test, Debian's chromium.
+missing=""
+command -v blender >/dev/null 2>&1 || missing="$missing blender"
+[ -x /usr/bin/chromium ] || missing="$missing chromium"
+if [ -n "$missing" ]; then
+    echo "== installing Debian's$missing"
     SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
     $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq blender >/dev/null
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
 fi
 
 python="$(command -v python3.11 || command -v python3)"

@@ -50,6 +50,10 @@ pub enum Error {
     /// No usable Blender: the message says where gloffuse looked and how to point at one.
     #[error("{0}")]
     BlenderNotFound(String),
+
+    /// The user interrupted a Blender run (Ctrl-C): it was stopped, and nothing written.
+    #[error("interrupted: Blender was stopped and nothing was written{}", log.as_ref().map(|l| format!(" (its log: {})", l.display())).unwrap_or_default())]
+    Interrupted { log: Option<PathBuf> },
 }
 
 /// A one-line message gets `; log: …; command: …` appended; a multi-line one (quoted

@@ -1,64 +1,215 @@
-//! Writing files so that a failure never leaves a partial file: write a temporary file in
-//! the destination's directory, then rename it into place.
+//! Writing the files the user names, so that a failure never leaves a partial file and
+//! nothing the user pointed at is replaced behind their back:
+//!
+//! - a regular file (or a new one) is written to a temporary file in its directory and
+//!   renamed over it, so it appears complete or not at all;
+//! - a symbolic link is followed: its target is written that way, and the link stays;
+//! - a FIFO, a character device, a socket, or a path into `/dev` or `/proc` (`/dev/stdout`)
+//!   is opened and written in place, as a stream;
+//! - `-` is standard output.
+//!
+//! One rule for folders: the folder an output goes in must exist; gloffuse makes none but
+//! the report folder itself.
 
 use std::io::Write;
-use std::path::Path;
+use std::os::unix::fs::FileTypeExt;
+use std::path::{Path, PathBuf};
 
 use crate::Error;
 
-/// Checks that `path` can be an output file: not a directory, and in a directory that
-/// exists. Commands call it before slow work (finding Blender, rendering), so that bad
-/// input fails fast; returns the directory the file goes in.
-pub fn check_destination(path: &Path) -> Result<&Path, Error> {
-    let fail = |message: String| Error::Write {
+/// Where the bytes for a path end up (see the module docs).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Destination {
+    /// `-`.
+    Stdout,
+    /// Opened and written in place.
+    Stream(PathBuf),
+    /// Written beside and renamed over: the path after following any links.
+    File(PathBuf),
+}
+
+fn fail(path: &Path, message: impl Into<String>) -> Error {
+    Error::Write {
         path: path.to_path_buf(),
-        message,
-    };
-    if path.is_dir() {
-        return Err(fail("it is a directory; give a file name".into()));
+        message: message.into(),
     }
+}
+
+/// How links are followed before giving up: the kernel's own limit.
+const MAX_LINKS: usize = 40;
+
+/// The path a chain of symbolic links ends at (it need not exist).
+fn follow_links(path: &Path) -> Result<PathBuf, Error> {
+    let mut at = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::read_link(&at) {
+            Ok(target) => {
+                at = match at.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            Err(_) => return Ok(at),
+        }
+    }
+    Err(fail(path, "too many levels of symbolic links"))
+}
+
+/// Checks that `path` can be an output and says how it will be written. Commands call it
+/// before slow work (finding Blender, rendering), so that bad input fails fast.
+pub fn check_destination(path: &Path) -> Result<Destination, Error> {
+    if path.as_os_str() == "-" {
+        return Ok(Destination::Stdout);
+    }
+    match std::fs::metadata(path) {
+        Ok(meta) => {
+            let kind = meta.file_type();
+            if kind.is_dir() {
+                return Err(fail(path, "it is a directory; give a file name"));
+            }
+            if kind.is_block_device() {
+                return Err(fail(path, "it is a block device; give a file name"));
+            }
+            // Paths into /dev and /proc (/dev/stdout, /dev/fd/3) name open files: stream.
+            let special = path.starts_with("/dev") || path.starts_with("/proc");
+            if kind.is_fifo() || kind.is_char_device() || kind.is_socket() || special {
+                return Ok(Destination::Stream(path.to_path_buf()));
+            }
+            let real = std::fs::canonicalize(path).map_err(|e| fail(path, e.to_string()))?;
+            Ok(Destination::File(real))
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            // A new file, or a dangling link: the file it names is made.
+            let real = follow_links(path)?;
+            let dir = match real.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            if !dir.is_dir() {
+                return Err(fail(
+                    path,
+                    format!("the directory {} does not exist", dir.display()),
+                ));
+            }
+            Ok(Destination::File(real))
+        }
+        Err(e) => Err(fail(path, e.to_string())),
+    }
+}
+
+/// Whether `path` is standard output: `-`, or the very file standard output is open on
+/// (`/dev/stdout`, `/proc/self/fd/1`, or the file it is redirected to).
+pub fn is_stdout(path: &Path) -> bool {
+    use std::os::fd::AsFd;
+    use std::os::unix::fs::MetadataExt;
+    if path.as_os_str() == "-" {
+        return true;
+    }
+    let stdout = std::io::stdout()
+        .as_fd()
+        .try_clone_to_owned()
+        .and_then(|fd| std::fs::File::from(fd).metadata());
+    match (stdout, std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => (a.dev(), a.ino()) == (b.dev(), b.ino()),
+        _ => false,
+    }
+}
+
+/// Writes `bytes` to `path` as [`check_destination`] says. A closed standard output is not
+/// an error (the reader has seen enough).
+pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    match check_destination(path)? {
+        Destination::Stdout => {
+            let mut out = std::io::stdout().lock();
+            match out.write_all(bytes).and_then(|()| out.flush()) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                    Err(fail(path, e.to_string()))
+                }
+                _ => Ok(()),
+            }
+        }
+        Destination::Stream(p) => std::fs::OpenOptions::new()
+            .write(true)
+            .open(&p)
+            .and_then(|mut f| f.write_all(bytes))
+            .map_err(|e| fail(path, e.to_string())),
+        Destination::File(real) => write_atomic(&real, bytes).map_err(|e| match e {
+            Error::Write { message, .. } => fail(path, message),
+            other => other,
+        }),
+    }
+}
+
+/// Writes `bytes` to the regular file `path` atomically (temporary file + rename in the
+/// same directory), keeping the permissions of a file it replaces.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     if !dir.is_dir() {
-        return Err(fail(format!(
-            "the directory {} does not exist",
-            dir.display()
-        )));
+        return Err(fail(
+            path,
+            format!("the directory {} does not exist", dir.display()),
+        ));
     }
-    Ok(dir)
-}
-
-/// Writes `bytes` to `path` atomically (temporary file + rename in the same directory).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let fail = |message: String| Error::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    let dir = check_destination(path)?;
+    let err = |e: std::io::Error| fail(path, e.to_string());
     let mut tmp = tempfile::Builder::new()
         .prefix(".gloffuse-")
         .suffix(".tmp")
         .tempfile_in(dir)
-        .map_err(|e| fail(e.to_string()))?;
-    tmp.write_all(bytes).map_err(|e| fail(e.to_string()))?;
+        .map_err(err)?;
+    tmp.write_all(bytes).map_err(err)?;
     // Temporary files are created private (0600); an output file should be as readable as
     // any other file the user writes.
     {
         use std::os::unix::fs::PermissionsExt;
-        let mode = if path.exists() {
-            std::fs::metadata(path)
-                .map(|m| m.permissions().mode())
-                .unwrap_or(0o644)
-        } else {
-            0o644
-        };
+        let mode = std::fs::metadata(path)
+            .map(|m| m.permissions().mode())
+            .unwrap_or(0o644);
         tmp.as_file()
             .set_permissions(std::fs::Permissions::from_mode(mode))
-            .map_err(|e| fail(e.to_string()))?;
+            .map_err(err)?;
     }
-    tmp.as_file().sync_all().map_err(|e| fail(e.to_string()))?;
-    tmp.persist(path).map_err(|e| fail(e.error.to_string()))?;
+    tmp.as_file().sync_all().map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error))?;
     Ok(())
+}
+
+/// Makes the report folder `dir` if it does not exist (its parent must), and checks that
+/// what is there is a folder.
+pub fn report_dir(dir: &Path) -> Result<(), Error> {
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => Err(fail(dir, "--report needs a directory, and this is a file")),
+        Err(_) => {
+            let parent = match dir.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            match std::fs::metadata(parent) {
+                Ok(m) if m.is_dir() => Ok(()),
+                Ok(_) => Err(fail(
+                    dir,
+                    format!(
+                        "--report needs a directory, but {} is a file",
+                        parent.display()
+                    ),
+                )),
+                Err(_) => Err(fail(
+                    dir,
+                    format!("the directory {} does not exist", parent.display()),
+                )),
+            }
+        }
+    }
+}
+
+/// [`report_dir`], then makes the folder.
+pub fn make_report_dir(dir: &Path) -> Result<(), Error> {
+    report_dir(dir)?;
+    match std::fs::create_dir(dir) {
+        Err(e) if e.kind() != std::io::ErrorKind::AlreadyExists => Err(fail(dir, e.to_string())),
+        _ => Ok(()),
+    }
 }

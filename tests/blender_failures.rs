@@ -316,6 +316,65 @@ fn a_hang_in_the_version_probe_ends_at_the_timeout() {
     }
 }
 
+/// Ctrl-C while Blender renders: gloffuse stops Blender (its whole process group), says
+/// so, writes no report, and exits 130.
+#[test]
+fn ctrl_c_stops_blender_and_exits_130() {
+    let s = setup("Blender 4.5.0", |notes| {
+        let notes = notes.display();
+        format!("echo $$ > '{notes}/group'\nsleep 1000 &\nwait")
+    });
+    let report = s.out.join("report");
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("gloffuse"))
+        .args(["verify", "-r", "0.5", "--no-provision", "--report"])
+        .arg(&report)
+        .arg("--blender")
+        .arg(&s.blender)
+        .current_dir(&s.out)
+        .env("XDG_CACHE_HOME", &s.cache)
+        .env_remove("GLOFFUSE_BLENDER")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let group = s.notes.join("group");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while !group.exists() {
+        assert!(Instant::now() < deadline, "the stand-in never started");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    // SAFETY: kill only sends a signal to the child we spawned.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+        0
+    );
+    let start = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        start.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        start.elapsed()
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(
+        stderr.contains("interrupted: Blender was stopped and nothing was written"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!report.exists(), "no report after an interrupt");
+    let group: u32 = fs::read_to_string(&group).unwrap().trim().parse().unwrap();
+    let deadline = Instant::now() + Duration::from_secs(5);
+    while !alive_in_group(group).is_empty() {
+        assert!(
+            Instant::now() < deadline,
+            "the stand-in's group outlived the interrupt"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
 #[test]
 fn a_traceback_is_quoted() {
     let s = setup("Blender 4.5.0", |_| {

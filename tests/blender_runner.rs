@@ -669,3 +669,79 @@ fn real_bpy_4_5() {
 fn real_bpy_5_0() {
     check_real("5.0", BlenderKind::PythonModule, 5, 0);
 }
+
+/// Two first runs at once (parallel CI jobs sharing one cache): pip runs once, under a
+/// lock; the second waits, says so, and uses the first one's install.
+#[test]
+fn concurrent_first_runs_install_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let count = dir.path().join("pip-runs");
+    fake_base_python(
+        &dir.path().join("bin"),
+        &format!(
+            "echo run >> '{}'; sleep 2; echo 'Successfully installed bpy-4.5.9'; exit 0",
+            count.display()
+        ),
+    );
+    let (env, cache) = provisioning_env(dir.path());
+    struct Notices(std::sync::Mutex<Vec<String>>);
+    impl gloffuse::progress::Progress for Notices {
+        fn notice(&self, message: &str) {
+            self.0.lock().unwrap().push(message.to_string());
+        }
+    }
+    let notices = Notices(std::sync::Mutex::new(Vec::new()));
+    let found: Vec<Blender> = std::thread::scope(|scope| {
+        let runs: Vec<_> = (0..2)
+            .map(|i| {
+                let (env, notices) = (&env, &notices);
+                scope.spawn(move || {
+                    std::thread::sleep(Duration::from_millis(300 * i));
+                    let opts = FindOptions {
+                        allow_provision: true,
+                        installer_output: InstallerOutput::Log,
+                        ..Default::default()
+                    };
+                    find_blender_in(&opts, env, notices).unwrap()
+                })
+            })
+            .collect();
+        runs.into_iter().map(|r| r.join().unwrap()).collect()
+    });
+    assert_eq!(found[0], found[1]);
+    assert_eq!(
+        fs::read_to_string(&count).unwrap().lines().count(),
+        1,
+        "pip ran once"
+    );
+    let notices = notices.0.into_inner().unwrap();
+    assert!(
+        notices.iter().any(|n| n.contains("waiting for it")),
+        "{notices:?}"
+    );
+    assert_eq!(leftovers(&cache), ["bpy-4.5"]);
+}
+
+/// An install killed half-way leaves a `.partial` folder, never trusted: the next install
+/// removes it and makes a complete venv.
+#[test]
+fn a_killed_install_is_never_trusted() {
+    let dir = tempfile::tempdir().unwrap();
+    fake_base_python(
+        &dir.path().join("bin"),
+        "echo 'Successfully installed bpy-4.5.9'; exit 0",
+    );
+    let (env, cache) = provisioning_env(dir.path());
+    let stale = cache.join(".bpy-4.5.partial-killed");
+    fs::create_dir_all(stale.join("bin")).unwrap();
+    fs::write(stale.join("bin/python"), "half").unwrap();
+    let opts = FindOptions {
+        allow_provision: true,
+        installer_output: InstallerOutput::Log,
+        ..Default::default()
+    };
+    let b = find_blender_in(&opts, &env, &Quiet).unwrap();
+    assert_eq!(b.program, cache.join("bpy-4.5/bin/python"));
+    assert!(!stale.exists(), "the killed install's folder is gone");
+    assert_eq!(leftovers(&cache), ["bpy-4.5"]);
+}

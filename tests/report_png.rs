@@ -9,7 +9,7 @@ use gloffuse::measure::Distribution;
 use gloffuse::report::png::{PLOT_SIZE, brightness_plot, contact_sheet, sheet_labels};
 use gloffuse::verify::image::Rgba;
 use gloffuse::verify::plan::{Plan, RenderSettings};
-use gloffuse::verify::stats::{SphereStats, sphere_stats};
+use gloffuse::verify::stats::{RINGS, SphereStats, sphere_stats};
 use gloffuse::verify::{ReferenceSphere, RenderInfo, Row, VerifyReport};
 
 const CELL: usize = 16;
@@ -113,10 +113,12 @@ fn white_row(
         target: [1.0; 3],
         uncorrected_brightness: uncorrected.mean,
         brightness: corrected.mean,
+        deviation: (corrected.mean - 1.0).abs(),
         uncorrected,
         corrected,
         predicted_uncorrected,
         predicted_corrected: 1.0,
+        ring_targets: vec![[1.0; 3]; RINGS],
         worst_ring: 0.0,
         pass,
     }

@@ -218,3 +218,139 @@ fn verify_refuses_bad_input_before_rendering() {
             .stderr(predicates::str::contains(fragment));
     }
 }
+
+/// The CI outputs of a failing check (the seed coefficients, Blender 4.5): JUnit XML that
+/// CPython's own XML parser reads, with one test case per sphere, failures exactly where
+/// the table says FAIL, measured/predicted/tolerance properties, and the message and rerun
+/// command on each failure; and report.html, loaded and screenshotted by a real headless
+/// Chromium, whose banner shows the verdict's colour.
+#[test]
+fn junit_and_html_reports_of_a_failing_check() {
+    let Some(blender) = common::blender::real_blender("4.5") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let junit = dir.path().join("junit.xml");
+    let report = dir.path().join("report");
+    let (code, v, stderr) = verify_json(
+        &blender,
+        &[
+            "--coefficients",
+            "seed",
+            "--json",
+            "-r",
+            "0.5,1",
+            "--junit",
+            junit.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, 1, "{stderr}");
+    let failed: Vec<String> = v["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["pass"] == false)
+        .map(|r| {
+            let roughness = r["roughness"].as_f64().unwrap();
+            format!("{} r={roughness} mean", label(&r["distribution"]))
+        })
+        .collect();
+    assert!(!failed.is_empty());
+    let parsed = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(
+            "import json, sys, xml.etree.ElementTree as ET\n\
+             root = ET.parse(sys.argv[1]).getroot()\n\
+             cases = root.findall('.//testcase')\n\
+             out = {'tests': root.get('tests'), 'failures': root.get('failures'),\n\
+                    'failed': [c.get('name') for c in cases if c.find('failure') is not None],\n\
+                    'props': sorted({p.get('name') for c in cases for p in c.findall('.//property')}),\n\
+                    'text': [c.find('failure').text for c in cases if c.find('failure') is not None]}\n\
+             print(json.dumps(out))",
+        )
+        .arg(&junit)
+        .output()
+        .unwrap();
+    assert!(
+        parsed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&parsed.stderr)
+    );
+    let x: Value = serde_json::from_slice(&parsed.stdout).unwrap();
+    assert_eq!(x["tests"], v["rows"].as_array().unwrap().len().to_string());
+    let mut junit_failed: Vec<String> = x["failed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    junit_failed.sort();
+    let mut want = failed.clone();
+    want.sort();
+    assert_eq!(junit_failed, want);
+    for p in ["measured_percent", "predicted_percent", "tolerance_percent"] {
+        assert!(x["props"].as_array().unwrap().iter().any(|q| q == p), "{p}");
+    }
+    for text in x["text"].as_array().unwrap() {
+        let text = text.as_str().unwrap();
+        assert!(
+            text.contains("rerun: ") && text.contains("--coefficients seed"),
+            "{text}"
+        );
+    }
+
+    let page = report.join("report.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert_eq!(html.matches("<tr class=\"fail\">").count(), failed.len());
+    // Failures first.
+    let first_ok = html.find("<tr class=\"ok\">").unwrap_or(usize::MAX);
+    assert!(html.rfind("<tr class=\"fail\">").unwrap() < first_ok);
+    let Some(chromium) = common::browser() else {
+        return;
+    };
+    let shot = dir.path().join("page.png");
+    let profile = tempfile::tempdir().unwrap();
+    let run = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--window-size=1200,900",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .unwrap();
+    assert!(
+        shot.exists(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let image = image::open(&shot).unwrap().to_rgb8();
+    let banner = gloffuse::report::html::FAIL_COLOUR;
+    let want = [1, 3, 5].map(|i| u8::from_str_radix(&banner[i..i + 2], 16).unwrap());
+    let banner_pixels = image.pixels().filter(|p| p.0 == want).count();
+    assert!(
+        banner_pixels > 10_000,
+        "{banner_pixels} pixels of the FAIL banner"
+    );
+    // The thumbnails were drawn: plenty of distinct colours below the banner.
+    let distinct: std::collections::HashSet<[u8; 3]> = image.pixels().map(|p| p.0).collect();
+    assert!(distinct.len() > 200, "{} colours", distinct.len());
+}
+
+fn label(distribution: &Value) -> &'static str {
+    match distribution.as_str().unwrap() {
+        "beckmann" => "Beckmann",
+        "ggx" => "GGX",
+        _ => "Ashikhmin-Shirley",
+    }
+}

@@ -212,6 +212,7 @@ fn probe_kind(program: &Path, kind: BlenderKind, deadline: Instant) -> Result<Pr
         Err(e) => return not(format!("could not be run: {e}"), String::new()),
     };
     match exit {
+        Exit::Interrupted => return Err(Error::Interrupted { log: None }),
         Exit::TimedOut => {
             let limit = if timeout < PROBE_TIMEOUT {
                 " (--timeout)"

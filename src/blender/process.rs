@@ -6,7 +6,16 @@ use std::fs::File;
 use std::io;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::process::{Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+/// Set (by the binary's Ctrl-C handler) to ask the running child to be stopped: the wait
+/// loop of [`run_logged`] kills its process group and returns [`Exit::Interrupted`].
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// True while [`run_logged`] waits for a child, so an interrupt handler knows there is one
+/// to stop (rather than ending the process at once).
+pub static CHILD_RUNNING: AtomicBool = AtomicBool::new(false);
 
 /// How a child ended.
 #[derive(Debug)]
@@ -14,11 +23,30 @@ pub enum Exit {
     Finished(ExitStatus),
     /// The timeout passed; the child's process group was killed and the child reaped.
     TimedOut,
+    /// [`INTERRUPTED`] was set; the child's process group was killed and the child reaped.
+    Interrupted,
+}
+
+/// Kills `child`'s whole process group (its id is the child's pid: `process_group(0)`)
+/// and reaps it.
+fn kill_group(child: &mut std::process::Child) -> io::Result<()> {
+    // The child is not yet reaped, so its id cannot have been reused.
+    let killed = match libc::pid_t::try_from(child.id()) {
+        // SAFETY: killpg only sends a signal; it touches no memory of ours.
+        Ok(pgid) => (unsafe { libc::killpg(pgid, libc::SIGKILL) }) == 0,
+        Err(_) => false,
+    };
+    if !killed {
+        let _ = child.kill();
+    }
+    child.wait()?;
+    Ok(())
 }
 
 /// Runs `argv` in a process group of its own, stdin from /dev/null, stdout and stderr both
-/// to `out`, and waits at most `timeout`. On timeout the whole group is killed (SIGKILL)
-/// and the child reaped, so neither it nor its children outlive the call.
+/// to `out`, and waits at most `timeout`. On timeout, or when [`INTERRUPTED`] is set, the
+/// whole group is killed (SIGKILL) and the child reaped, so neither it nor its children
+/// outlive the call.
 pub fn run_logged(argv: &[OsString], out: &File, timeout: Duration) -> io::Result<Exit> {
     let (program, args) = argv
         .split_first()
@@ -33,25 +61,26 @@ pub fn run_logged(argv: &[OsString], out: &File, timeout: Duration) -> io::Resul
         .process_group(0);
     die_with_parent(&mut cmd);
     let mut child = cmd.spawn()?;
+    CHILD_RUNNING.store(true, Ordering::SeqCst);
+    let exit = wait_for(&mut child, timeout);
+    CHILD_RUNNING.store(false, Ordering::SeqCst);
+    exit
+}
+
+fn wait_for(child: &mut std::process::Child, timeout: Duration) -> io::Result<Exit> {
     let start = Instant::now();
     let mut pause = Duration::from_millis(2);
     loop {
         if let Some(status) = child.try_wait()? {
             return Ok(Exit::Finished(status));
         }
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            kill_group(child)?;
+            return Ok(Exit::Interrupted);
+        }
         let elapsed = start.elapsed();
         if elapsed >= timeout {
-            // The group id is the child's pid (process_group(0)); the child is not yet
-            // reaped, so the id cannot have been reused.
-            let killed = match libc::pid_t::try_from(child.id()) {
-                // SAFETY: killpg only sends a signal; it touches no memory of ours.
-                Ok(pgid) => (unsafe { libc::killpg(pgid, libc::SIGKILL) }) == 0,
-                Err(_) => false,
-            };
-            if !killed {
-                let _ = child.kill();
-            }
-            child.wait()?;
+            kill_group(child)?;
             return Ok(Exit::TimedOut);
         }
         std::thread::sleep(pause.min(timeout - elapsed));

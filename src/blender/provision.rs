@@ -47,6 +47,18 @@ pub(super) fn provision(
     // Fail before announcing or creating anything if the install cannot work.
     let python = base_python(env)?;
     std::fs::create_dir_all(parent).map_err(|e| write_err(parent, &e))?;
+    // One install at a time: a second gloffuse (a parallel CI job sharing the cache)
+    // waits for the first, then uses what it installed.
+    let _lock = InstallLock::take(&parent.join(format!(".bpy-{BPY_SERIES}.lock")), progress)?;
+    if venv_python(venv).exists() {
+        return probe_as(
+            &venv_python(venv),
+            Some(BlenderKind::PythonModule),
+            Source::Cache,
+            Instant::now() + PROBE_TIMEOUT,
+        );
+    }
+    remove_stale_partials(parent);
     for s in skipped {
         progress.notice(&format!("not using {s}"));
     }
@@ -157,6 +169,53 @@ pub(super) fn provision(
         Err(e) => {
             let _ = std::fs::remove_dir_all(venv);
             Err(e)
+        }
+    }
+}
+
+/// An exclusive `flock` on a lock file in the cache, held while this process installs bpy;
+/// the kernel releases it when the process ends, however it ends.
+struct InstallLock {
+    /// Closing it (on drop) releases the lock.
+    _file: File,
+}
+
+impl InstallLock {
+    fn take(path: &Path, progress: &dyn Progress) -> Result<Self, Error> {
+        use std::os::fd::AsRawFd;
+        let file = File::create(path).map_err(|e| Error::Write {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let fd = file.as_raw_fd();
+        // SAFETY: flock only locks the open file `fd` refers to.
+        if unsafe { libc::flock(fd, libc::LOCK_EX | libc::LOCK_NB) } != 0 {
+            progress.notice(&format!(
+                "another gloffuse is installing bpy {BPY_SERIES} into the cache; waiting for it ({})",
+                path.display()
+            ));
+            // SAFETY: as above; this call blocks until the other process is done.
+            if unsafe { libc::flock(fd, libc::LOCK_EX) } != 0 {
+                return Err(Error::Write {
+                    path: path.to_path_buf(),
+                    message: std::io::Error::last_os_error().to_string(),
+                });
+            }
+        }
+        Ok(InstallLock { _file: file })
+    }
+}
+
+/// Removes `.bpy-4.5.partial-*` folders an install left when it was killed: with the
+/// install lock held, nobody else is writing one.
+fn remove_stale_partials(parent: &Path) {
+    let prefix = format!(".bpy-{BPY_SERIES}.partial-");
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        if entry.file_name().to_string_lossy().starts_with(&prefix) {
+            let _ = std::fs::remove_dir_all(entry.path());
         }
     }
 }

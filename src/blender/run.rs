@@ -107,6 +107,11 @@ pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
     let seconds = start.elapsed().as_secs_f64();
     drop(log);
     let status = match exit {
+        Exit::Interrupted => {
+            return Err(Error::Interrupted {
+                log: Some(run.log.clone()),
+            });
+        }
         Exit::TimedOut => {
             return Err(fail(format!(
                 "Blender timed out after {} s (--timeout)",

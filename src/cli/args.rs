@@ -558,9 +558,16 @@ pub struct VerifyArgs {
     #[arg(long, default_value_t = verify_defaults().judging.ring_tolerance_percent, value_parser = parse_tolerance)]
     pub ring_tolerance: f64,
 
-    /// Also write report.json, the rendered sweep.exr, contact-sheet.png and brightness.png here.
+    /// Also write report.html (a page with every sphere, failures first), report.json, the
+    /// rendered sweep.exr, contact-sheet.png, brightness.png and deviation.png into this
+    /// folder (made if missing; its parent must exist).
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
+
+    /// Also write the verdict as JUnit XML (one test case per sphere, and per sphere's rings
+    /// in the view modes) for a CI server.
+    #[arg(long, value_name = "FILE.xml")]
+    pub junit: Option<PathBuf>,
 
     #[command(flatten)]
     pub blender: BlenderArgs,

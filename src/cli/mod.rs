@@ -1,8 +1,8 @@
 //! The binary's edge: parse the command line, call the library, print what it returns, and
 //! map the outcome to an exit code. Nothing below this module parses flags or prints.
 //!
-//! Exit codes: 0 success, 1 a check failed, 2 an error. A closed stdout (`gloffuse … | head`)
-//! ends the program quietly with 0, as ripgrep does.
+//! Exit codes: 0 success, 1 a check failed, 2 an error, 130 interrupted (Ctrl-C). A closed
+//! stdout (`gloffuse … | head`) ends the program quietly with 0, as ripgrep does.
 
 mod args;
 mod progress;
@@ -11,6 +11,7 @@ mod text;
 use clap::Parser;
 use serde_json::json;
 use std::io::{self, Write};
+use std::path::Path;
 use std::process::ExitCode;
 
 use args::{AlbedoArgs, Cli, CoefficientsCommand, Command, FitArgs};
@@ -19,7 +20,7 @@ use gloffuse::fit::coefficients::{INTEGRATOR_DEGREE, PRESETS, today};
 use gloffuse::fit::{Coefficients, POINTS_DEGREE, fit_points};
 use gloffuse::measure::brdf::{Model, model_albedo, model_average_albedo};
 use gloffuse::measure::{AlbedoIntegrator, Glossy, Roughness};
-use gloffuse::output::{check_destination, write_atomic};
+use gloffuse::output::{check_destination, is_stdout, write_output};
 use gloffuse::progress::Quiet;
 use progress::{Terminal, eprintln_quietly};
 
@@ -51,7 +52,32 @@ impl From<io::Error> for Failure {
 
 type Result<T> = std::result::Result<T, Failure>;
 
+/// Ctrl-C: while a Blender run is waited for, ask the library to stop it (the run then
+/// fails with `Error::Interrupted`, nothing is written, and `main` exits 130); otherwise end
+/// at once. Only async-signal-safe calls here.
+extern "C" fn on_interrupt(_: libc::c_int) {
+    use gloffuse::blender::process::{CHILD_RUNNING, INTERRUPTED};
+    use std::sync::atomic::Ordering;
+    if CHILD_RUNNING.load(Ordering::SeqCst) {
+        INTERRUPTED.store(true, Ordering::SeqCst);
+    } else {
+        let message = b"\ngloffuse: interrupted; nothing was written\n";
+        // SAFETY: write and _exit are async-signal-safe.
+        unsafe {
+            libc::write(2, message.as_ptr().cast(), message.len());
+            libc::_exit(130);
+        }
+    }
+}
+
 pub fn main() -> ExitCode {
+    // SAFETY: installs a handler that only touches atomics and calls write/_exit.
+    unsafe {
+        libc::signal(
+            libc::SIGINT,
+            on_interrupt as *const () as libc::sighandler_t,
+        );
+    }
     let cli = Cli::parse();
     let mut out = io::stdout().lock();
     let outcome = run(cli, &mut out).and_then(|o| {
@@ -65,6 +91,10 @@ pub fn main() -> ExitCode {
         Err(Failure::Stdout(e)) => {
             eprintln_quietly(&format!("error: cannot write to standard output: {e}"));
             ExitCode::from(2)
+        }
+        Err(Failure::Library(e @ Error::Interrupted { .. })) => {
+            eprintln_quietly(&format!("gloffuse: {e}"));
+            ExitCode::from(130)
         }
         Err(Failure::Library(e)) => {
             eprintln_quietly(&format!("error: {}", chain(&e)));
@@ -84,39 +114,75 @@ fn chain(e: &dyn std::error::Error) -> String {
     text
 }
 
+/// Where a command's summary goes: stdout, unless one of its outputs is stdout itself
+/// (`-`, `/dev/stdout`), then stderr.
+fn summary<'a>(
+    out: &'a mut dyn Write,
+    err: &'a mut dyn Write,
+    outputs: &[Option<&Path>],
+) -> &'a mut dyn Write {
+    if outputs.iter().flatten().any(|p| is_stdout(p)) {
+        err
+    } else {
+        out
+    }
+}
+
 fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
     let terminal = Terminal::default();
+    let mut stderr = io::stderr();
     match cli.command {
         Command::Albedo(a) => albedo(&a, out),
-        Command::Fit(f) => fit(&f, out),
+        Command::Fit(f) => {
+            let out = summary(out, &mut stderr, &[f.out.as_deref()]);
+            fit(&f, out)
+        }
         Command::Generate(g) => {
             let generated = gloffuse::generate::generate(&g.options(), &terminal)?;
-            emit(out, g.json, &generated, text::generated)?;
+            let outputs = [g.script.as_deref(), g.blend.as_deref()];
+            emit(
+                summary(out, &mut stderr, &outputs),
+                g.json,
+                &generated,
+                text::generated,
+            )?;
             Ok(Outcome::Success)
         }
         Command::Verify(v) => {
-            // The report folder is checked before any slow work: bad input fails fast.
+            // Report outputs are checked before any slow work: bad input fails fast.
             if let Some(dir) = &v.report {
                 gloffuse::report::check_dir(dir)?;
             }
+            if let Some(path) = &v.junit {
+                check_destination(path)?;
+            }
             let verification = gloffuse::verify::verify(&v.options(), &terminal)?;
+            let rerun = this_command();
             if let Some(dir) = &v.report {
-                for p in gloffuse::report::write_files(dir, &verification)? {
+                for p in gloffuse::report::write_files(dir, &verification, &rerun)? {
                     eprintln_quietly(&format!("wrote {}", p.display()));
                 }
             }
             let report = &verification.report;
+            if let Some(path) = &v.junit {
+                let xml = gloffuse::report::junit::render(report, &rerun);
+                write_output(path, xml.as_bytes())?;
+                eprintln_quietly(&format!("wrote {}", path.display()));
+            }
+            let out = summary(out, &mut stderr, &[v.junit.as_deref()]);
             emit(out, v.json, report, gloffuse::report::table::render)?;
             Ok(verdict(report.pass))
         }
         Command::Refresh(a) => {
             let r = gloffuse::refresh::refresh(&a.options(), &terminal)?;
+            let out = summary(out, &mut stderr, &[Some(a.out.as_path())]);
             emit(out, a.json, &r, text::refresh)?;
             Ok(verdict(r.verify.as_ref().is_none_or(|v| v.pass)))
         }
         Command::Lut(l) => {
-            let summary = gloffuse::lut::lut(&l.options(), &terminal)?;
-            emit(out, l.json, &summary, text::lut)?;
+            let written = gloffuse::lut::lut(&l.options(), &terminal)?;
+            let out = summary(out, &mut stderr, &[Some(l.out.as_path())]);
+            emit(out, l.json, &written, text::lut)?;
             Ok(Outcome::Success)
         }
         Command::Bench(b) => {
@@ -132,6 +198,12 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             action: CoefficientsCommand::Show { source, json },
         } => show(source.as_deref(), json, out),
     }
+}
+
+/// The command line this process was started with, quoted for a shell: how to rerun it.
+fn this_command() -> String {
+    let argv: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    gloffuse::blender::process::shell_join(&argv)
 }
 
 fn verdict(pass: bool) -> Outcome {
@@ -179,7 +251,7 @@ fn albedo(a: &AlbedoArgs, out: &mut dyn Write) -> Result<Outcome> {
         let n = a.grid as usize;
         let mus: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
         let grid = integrator.grid(distribution, masking, &Roughness::grid(n), &mus, &Quiet);
-        write_atomic(path, grid.csv().as_bytes())?;
+        write_output(path, grid.csv().as_bytes())?;
         eprintln_quietly(&format!(
             "wrote {} ({n}×{n} grid, {} masking, Blender {})",
             path.display(),

@@ -10,7 +10,7 @@ use crate::Error;
 use crate::measure::{
     AlbedoIntegrator, BlenderVersion, Distribution, Masking, Quadrature, Roughness,
 };
-use crate::output::write_atomic;
+use crate::output::write_output;
 use crate::progress::Quiet;
 
 pub const FORMAT: &str = "gloffuse-coefficients";
@@ -276,7 +276,7 @@ impl Coefficients {
     pub fn write(&self, path: &Path) -> Result<(), Error> {
         let text = self.to_json();
         Self::parse(&text, &path.display().to_string())?;
-        write_atomic(path, text.as_bytes())
+        write_output(path, text.as_bytes())
     }
 
     /// A preset or file by name, or else the preset for `version`'s masking family;

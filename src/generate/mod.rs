@@ -19,7 +19,7 @@ use crate::Error;
 use crate::blender::{BlenderOptions, Run, command_line, run_script};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Masking};
-use crate::output::{check_destination, write_atomic};
+use crate::output::{Destination, check_destination, write_output};
 use crate::progress::Progress;
 use blend::{incomplete_blend, starts_like_blend, temp_beside};
 
@@ -134,7 +134,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     };
     let Some(blender) = blender else {
         if let Some(path) = &g.script {
-            write_atomic(path, script.as_bytes())?;
+            write_output(path, script.as_bytes())?;
             out.script = Some(path.clone());
         }
         return Ok(out);
@@ -142,13 +142,21 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
 
     let run_dir = crate::blender::runs::new_run_dir("generate")?;
     let script_path = run_dir.join("gloffuse-generate.py");
-    write_atomic(&script_path, script.as_bytes())?;
+    write_output(&script_path, script.as_bytes())?;
     let dest = g
         .blend
         .clone()
         .or_else(|| g.into.clone())
         .expect("needs_blender");
-    let tmp = temp_beside(&dest, ".blend")?;
+    // Blender saves beside the file it replaces (relative paths in the .blend stay
+    // right), or, for a stream, in the run folder.
+    let target = check_destination(&dest)?;
+    let tmp = match &target {
+        Destination::File(real) => temp_beside(real, ".blend")?,
+        Destination::Stream(_) | Destination::Stdout => {
+            temp_beside(&run_dir.join("out"), ".blend")?
+        }
+    };
     let mut args: Vec<OsString> = Vec::new();
     if let Some(into) = &g.into {
         args.extend([OsString::from("--open"), into.clone().into_os_string()]);
@@ -172,24 +180,33 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     }
     // Only now, with the .blend made, the script: a failed run leaves no output at all.
     if let Some(path) = &g.script {
-        write_atomic(path, script.as_bytes())?;
+        write_output(path, script.as_bytes())?;
         out.script = Some(path.clone());
     }
-    if g.into.is_some() {
+    if let (Some(_), Destination::File(real)) = (&g.into, &target) {
         // Blender's own convention: the previous version stays beside the file as .blend1.
-        let mut backup = dest.clone().into_os_string();
+        let mut backup = real.clone().into_os_string();
         backup.push("1");
         let backup = PathBuf::from(backup);
-        std::fs::copy(&dest, &backup).map_err(|e| Error::Write {
+        std::fs::copy(real, &backup).map_err(|e| Error::Write {
             path: backup.clone(),
             message: e.to_string(),
         })?;
         out.backup = Some(backup);
     }
-    tmp.persist(&dest).map_err(|e| Error::Write {
-        path: dest.clone(),
-        message: e.error.to_string(),
-    })?;
+    match &target {
+        Destination::File(real) => tmp.persist(real).map_err(|e| Error::Write {
+            path: dest.clone(),
+            message: e.error.to_string(),
+        })?,
+        Destination::Stream(_) | Destination::Stdout => {
+            let bytes = std::fs::read(&tmp).map_err(|source| Error::Read {
+                path: tmp.to_path_buf(),
+                source,
+            })?;
+            write_output(&dest, &bytes)?;
+        }
+    }
     out.blend = Some(dest);
     out.log = Some(log);
     Ok(out)

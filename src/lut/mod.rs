@@ -50,7 +50,7 @@ use std::time::Instant;
 
 use crate::Error;
 use crate::measure::{BlenderVersion, Distribution};
-use crate::output::{check_destination, write_atomic};
+use crate::output::{check_destination, write_output};
 use crate::progress::Progress;
 
 /// The largest `--size` accepted: 8192² texels of RGBA32F is already 1 GiB.
@@ -483,7 +483,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         path: args.out.clone(),
         message: format!("cannot encode the table as {}: {message}", format.key()),
     })?;
-    write_atomic(&args.out, &bytes)?;
+    write_output(&args.out, &bytes)?;
     let (samples, g_model, sampling, distribution, blender_version, channels) = match spec {
         Spec::SplitSum {
             samples,

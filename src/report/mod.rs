@@ -1,52 +1,45 @@
 //! ⑤ Report: renderers of the verify verdict, one file each — `table` (terminal), `json`
-//! (machines), `png` (the contact sheet and the brightness plot) — and the report folder
+//! (machines), `junit` (CI servers), `html` (a page for people), `png` (the contact sheet
+//! and the brightness plot), `deviation` (the false-colour view) — and the report folder
 //! that holds them with the rendered EXR.
 
+pub mod deviation;
+pub mod html;
 pub mod json;
+pub mod junit;
 pub mod png;
 pub mod table;
 
 use std::path::{Path, PathBuf};
 
 use crate::Error;
-use crate::output::write_atomic;
+use crate::output::{self, write_output};
 use crate::verify::Verification;
 
-/// Checks that `dir` can become a report folder: it is made if needed, so the nearest part
-/// of it that exists must be a directory. Called before any slow work.
+/// Checks that `dir` can become a report folder: it is made if missing, but its parent
+/// must exist. Called before any slow work.
 pub fn check_dir(dir: &Path) -> Result<(), Error> {
-    let Some(file) = dir.ancestors().find(|a| a.exists() && !a.is_dir()) else {
-        return Ok(());
-    };
-    Err(Error::Write {
-        path: dir.to_path_buf(),
-        message: if file == dir {
-            "--report needs a directory, and this is a file".into()
-        } else {
-            format!(
-                "--report needs a directory, but {} is a file",
-                file.display()
-            )
-        },
-    })
+    output::report_dir(dir)
 }
 
-/// Writes report.json, sweep.exr, contact-sheet.png and brightness.png into `dir`
-/// (created if needed); returns the paths written.
-pub fn write_files(dir: &Path, verification: &Verification) -> Result<Vec<PathBuf>, Error> {
+/// Writes report.json, sweep.exr, contact-sheet.png, brightness.png, deviation.png and
+/// report.html into `dir` (made if missing; its parent must exist); returns the paths
+/// written. `rerun` is the command line of the check, for the page.
+pub fn write_files(
+    dir: &Path,
+    verification: &Verification,
+    rerun: &str,
+) -> Result<Vec<PathBuf>, Error> {
     let Verification { report, rendered } = verification;
-    std::fs::create_dir_all(dir).map_err(|e| Error::Write {
-        path: dir.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    output::make_report_dir(dir)?;
     let json_path = dir.join("report.json");
-    write_atomic(&json_path, json::render(report).as_bytes())?;
+    write_output(&json_path, json::render(report).as_bytes())?;
     let exr_path = dir.join("sweep.exr");
     let bytes = std::fs::read(&rendered.exr).map_err(|source| Error::Read {
         path: rendered.exr.clone(),
         source,
     })?;
-    write_atomic(&exr_path, &bytes)?;
+    write_output(&exr_path, &bytes)?;
     let sheet = dir.join("contact-sheet.png");
     let (rows, columns) = png::sheet_labels(&rendered.plan);
     png::contact_sheet(
@@ -58,5 +51,18 @@ pub fn write_files(dir: &Path, verification: &Verification) -> Result<Vec<PathBu
     )?;
     let plot = dir.join("brightness.png");
     png::brightness_plot(report, &plot)?;
-    Ok(vec![json_path, exr_path, sheet, plot])
+    let false_colour = dir.join("deviation.png");
+    deviation::sheet(report, rendered, &false_colour)?;
+    let mut written = vec![json_path, exr_path, sheet, plot, false_colour];
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    let page = dir.join("report.html");
+    write_output(
+        &page,
+        html::render(report, rendered, rerun, &names).as_bytes(),
+    )?;
+    written.push(page);
+    Ok(written)
 }

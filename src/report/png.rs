@@ -15,7 +15,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::Error;
 use crate::measure::Distribution;
-use crate::output::write_atomic;
+use crate::output::write_output;
 use crate::verify::VerifyReport;
 use crate::verify::image::Rgba;
 use crate::verify::plan::{Plan, Role};
@@ -25,14 +25,14 @@ use crate::verify::plan::{Plan, Role};
 pub const BACKGROUND: f32 = 0.18;
 
 /// Size of the brightness plot in pixels.
-pub const PLOT_SIZE: (u32, u32) = (900, 600);
+pub const PLOT_SIZE: (u32, u32) = (900, 820);
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-const FAMILY: &str = "sans-serif";
+pub(super) const FAMILY: &str = "sans-serif";
 
 /// Label column and header of the contact sheet (sRGB).
-const LABEL_BACKGROUND: RGBColor = RGBColor(40, 40, 40);
-const LABEL_TEXT: RGBColor = RGBColor(235, 235, 235);
+pub(super) const LABEL_BACKGROUND: RGBColor = RGBColor(40, 40, 40);
+pub(super) const LABEL_TEXT: RGBColor = RGBColor(235, 235, 235);
 
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value clamped to [0, 1], as an
 /// 8-bit code value. NaN gives 0.
@@ -284,17 +284,36 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
     let (x_lo, x_hi) = (x_lo - x_pad, x_hi + x_pad);
 
     let title = format!(
-        "Furnace brightness · Blender {} · coefficients {}",
+        "Furnace brightness · Blender {} · coefficients {} · {} spp",
         report.render.blender_version,
-        shorten(&report.coefficients, 40)
+        shorten(&report.coefficients, 36),
+        report.render.samples
     );
+    // The zoomed panel: corrected spheres' distance from what they promise.
+    let zoom: Vec<(Distribution, Points)> = distributions
+        .iter()
+        .map(|&d| {
+            let rows = report.rows.iter().filter(|r| r.distribution == d);
+            let mut points: Points = rows
+                .map(|r| (r.roughness, 100.0 * (r.brightness - 1.0)))
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect();
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (d, points)
+        })
+        .collect();
+    let zoom_half = zoom
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|(_, y)| y.abs() * 1.25))
+        .fold((3.0 * tolerance).max(0.5), f64::max);
     let (w, h) = PLOT_SIZE;
     let mut rgb = vec![255u8; (w * h * 3) as usize];
     {
         let root = backend(&mut rgb, (w, h), out)?.into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(&e))?;
         let below_title = root.titled(&title, (FAMILY, 20)).map_err(|e| fail(&e))?;
-        let (plot_area, legend_area) = below_title.split_horizontally(w as i32 - LEGEND_WIDTH);
+        let (left_area, legend_area) = below_title.split_horizontally(w as i32 - LEGEND_WIDTH);
+        let (plot_area, zoom_area) = left_area.split_vertically((h as f64 * 0.64) as i32);
         let mut chart = ChartBuilder::on(&plot_area)
             .margin(12)
             .x_label_area_size(44)
@@ -404,6 +423,56 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             ));
         }
         draw_legend(&legend_area, &legend).map_err(|e| fail(&e))?;
+
+        let mut chart = ChartBuilder::on(&zoom_area)
+            .margin(12)
+            .caption(
+                "corrected, zoomed: distance from what the correction promises",
+                (FAMILY, 14),
+            )
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x_lo..x_hi, -zoom_half..zoom_half)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("roughness")
+            .y_desc("deviation (%)")
+            .axis_desc_style((FAMILY, 15))
+            .label_style((FAMILY, 13))
+            .x_labels(11)
+            .y_labels(9)
+            .x_label_formatter(&|x| format!("{x:.1}"))
+            .y_label_formatter(&|y| format!("{y:+.1}"))
+            .light_line_style(RGBColor(242, 242, 242))
+            .bold_line_style(RGBColor(215, 215, 215))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        if tolerance > 0.0 {
+            chart
+                .draw_series([Rectangle::new(
+                    [(x_lo, -tolerance), (x_hi, tolerance)],
+                    PASS_BAND.mix(0.12).filled(),
+                )])
+                .map_err(|e| fail(&e))?;
+        }
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x_lo, 0.0), (x_hi, 0.0)],
+                8,
+                5,
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| fail(&e))?;
+        for (d, points) in &zoom {
+            let c = colour(*d);
+            chart
+                .draw_series(LineSeries::new(points.iter().copied(), c.stroke_width(1)))
+                .map_err(|e| fail(&e))?;
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled())))
+                .map_err(|e| fail(&e))?;
+        }
         root.present().map_err(|e| fail(&e))?;
     }
     write_png(&rgb, (w, h), out)
@@ -487,7 +556,7 @@ fn shorten(text: &str, max: usize) -> String {
     }
 }
 
-fn write_error(out: &Path, message: impl Display) -> Error {
+pub(super) fn write_error(out: &Path, message: impl Display) -> Error {
     Error::Write {
         path: out.to_path_buf(),
         message: message.to_string(),
@@ -495,7 +564,7 @@ fn write_error(out: &Path, message: impl Display) -> Error {
 }
 
 /// Registers the embedded DejaVu Sans as plotters' `sans-serif` (once per process).
-fn register_font() -> Result<(), String> {
+pub(super) fn register_font() -> Result<(), String> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
@@ -505,14 +574,14 @@ fn register_font() -> Result<(), String> {
         .clone()
 }
 
-fn text_size(text: &str, px: f64) -> Result<(u32, u32), String> {
+pub(super) fn text_size(text: &str, px: f64) -> Result<(u32, u32), String> {
     (FAMILY, px)
         .into_font()
         .box_size(text)
         .map_err(|e| format!("cannot lay out the label '{text}': {e}"))
 }
 
-fn backend<'a>(
+pub(super) fn backend<'a>(
     rgb: &'a mut [u8],
     size: (u32, u32),
     out: &Path,
@@ -521,10 +590,31 @@ fn backend<'a>(
         .map_err(|e| write_error(out, format!("cannot draw: {e}")))
 }
 
-fn write_png(rgb: &[u8], (w, h): (u32, u32), out: &Path) -> Result<(), Error> {
+/// RGB bytes as a PNG file in memory.
+pub fn encode_png(rgb: &[u8], (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
     let mut bytes = Vec::new();
     PngEncoder::new(&mut bytes)
         .write_image(rgb, w, h, ExtendedColorType::Rgb8)
-        .map_err(|e| write_error(out, format!("cannot encode PNG: {e}")))?;
-    write_atomic(out, &bytes)
+        .map_err(|e| format!("cannot encode PNG: {e}"))?;
+    Ok(bytes)
+}
+
+pub(super) fn write_png(rgb: &[u8], size: (u32, u32), out: &Path) -> Result<(), Error> {
+    let bytes = encode_png(rgb, size).map_err(|e| write_error(out, e))?;
+    write_output(out, &bytes)
+}
+
+/// Grid cell `index` of a rendered sweep as the contact sheet shows it (over the grey
+/// background, sRGB-encoded): RGB bytes, `cell × cell`.
+pub fn cell_image(image: &Rgba, columns: usize, cell: usize, index: usize) -> Vec<u8> {
+    let (x0, y0) = ((index % columns) * cell, (index / columns) * cell);
+    let mut rgb = Vec::with_capacity(cell * cell * 3);
+    for y in 0..cell {
+        for x in 0..cell {
+            let [r, g, b, a] = image.pixels[(y0 + y) * image.width + x0 + x];
+            let under = (1.0 - a.clamp(0.0, 1.0)) * BACKGROUND;
+            rgb.extend_from_slice(&[srgb8(r + under), srgb8(g + under), srgb8(b + under)]);
+        }
+    }
+    rgb
 }

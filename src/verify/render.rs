@@ -10,7 +10,7 @@ use super::stats::{SphereStats, sphere_stats};
 use crate::Error;
 use crate::blender::{Blender, Run, command_line, run_script, runs};
 use crate::generate::{GenerateParams, Job, Mode, assemble};
-use crate::output::write_atomic;
+use crate::output::write_output;
 use crate::progress::Progress;
 
 /// How a sweep was rendered: which Blender, the settings, and how to rerun it.
@@ -54,7 +54,7 @@ pub fn render(
     let exr = run_dir.join("sweep.exr");
     let params = plan.params(groups, mode, color, &exr);
     let script = run_dir.join("gloffuse-furnace.py");
-    write_atomic(&script, assemble(&params, Job::Furnace).as_bytes())?;
+    write_output(&script, assemble(&params, Job::Furnace).as_bytes())?;
     let log = run_dir.join("blender.log");
     let run = Run {
         blender,

@@ -52,11 +52,16 @@ pub struct Row {
     pub uncorrected_brightness: f64,
     /// The corrected sphere's mean relative to `target`, the channels averaged: 1 is right.
     pub brightness: f64,
+    /// The worst channel's |mean / target − 1|.
+    pub deviation: f64,
     /// The integrator's E_avg(r) for this Blender's masking (0–1).
     pub predicted_uncorrected: f64,
     /// What the coefficients should give relative to `target` (gain(r) · E_avg(r) for a
     /// white sphere; 1 in the view modes).
     pub predicted_corrected: f64,
+    /// What the colour model promises each view-cosine ring of the corrected sphere (in the
+    /// order of its rings), per channel: for a pixel-exact correction, every pixel's target.
+    pub ring_targets: Vec<[f64; 3]>,
     /// Largest |ring mean / ring target − 1| of the corrected sphere over its view-cosine
     /// rings and channels.
     pub worst_ring: f64,
@@ -95,11 +100,12 @@ pub struct VerifyReport {
 
 /// The largest |ring mean / its target − 1| over the view-cosine rings (with at least
 /// [`MIN_RING_PIXELS`] pixels) and channels of a sphere.
-fn worst_ring(s: &SphereStats, target: impl Fn((f64, f64)) -> [f64; 3]) -> f64 {
+fn worst_ring(s: &SphereStats, targets: &[[f64; 3]]) -> f64 {
     s.rings
         .iter()
-        .filter(|r| r.pixels >= MIN_RING_PIXELS)
-        .map(|r| relative(r.mean_rgb, target(r.mu)).1)
+        .zip(targets)
+        .filter(|(r, _)| r.pixels >= MIN_RING_PIXELS)
+        .map(|(r, &t)| relative(r.mean_rgb, t).1)
         .fold(0.0, f64::max)
 }
 
@@ -200,10 +206,15 @@ pub fn judge(
             let uncorrected = find(Role::Uncorrected(d), r);
             let (brightness, deviation) = relative(corrected.mean_rgb, target);
             // Every pixel's target: shown in every mode, judged in the view modes.
-            let worst_ring = worst_ring(&corrected, |mu| {
-                let e = ring_albedo(&integrator, &glossy, mu);
-                self::target(color_model, color, e_avg, e)
-            });
+            let ring_targets: Vec<[f64; 3]> = corrected
+                .rings
+                .iter()
+                .map(|ring| {
+                    let e = ring_albedo(&integrator, &glossy, ring.mu);
+                    self::target(color_model, color, e_avg, e)
+                })
+                .collect();
+            let worst_ring = worst_ring(&corrected, &ring_targets);
             let rings_flat =
                 mode == Mode::Roughness || worst_ring <= judging.ring_tolerance_percent / 100.0;
             // What the roughness-only gain g gives: C g E_avg (exact), or
@@ -218,7 +229,9 @@ pub fn judge(
                 uncorrected_brightness: relative(uncorrected.mean_rgb, color).0,
                 uncorrected,
                 pass: deviation <= tolerance && rings_flat,
+                deviation,
                 worst_ring,
+                ring_targets,
                 brightness,
                 target,
                 corrected,

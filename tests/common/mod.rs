@@ -9,3 +9,25 @@ pub mod oracle;
 pub fn gloffuse() -> assert_cmd::Command {
     assert_cmd::Command::cargo_bin("gloffuse").expect("the gloffuse binary is built")
 }
+
+/// A headless browser for the report page: `$GLOFFUSE_TEST_CHROMIUM`, else Debian's
+/// `/usr/bin/chromium` (which `scripts/test.sh` installs). A missing one fails the test
+/// unless `GLOFFUSE_SKIP_BROWSER_TESTS=1`, and then the test says what it skipped.
+pub fn browser() -> Option<std::path::PathBuf> {
+    let path = std::env::var_os("GLOFFUSE_TEST_CHROMIUM")
+        .map_or_else(|| std::path::PathBuf::from("/usr/bin/chromium"), Into::into);
+    if path.exists() {
+        return Some(path);
+    }
+    let why = format!(
+        "{} not found (set GLOFFUSE_TEST_CHROMIUM, or run scripts/test.sh)",
+        path.display()
+    );
+    let skip = std::env::var_os("GLOFFUSE_SKIP_BROWSER_TESTS").is_some_and(|v| v == "1");
+    assert!(
+        skip,
+        "{why}; set GLOFFUSE_SKIP_BROWSER_TESTS=1 to skip the browser check"
+    );
+    eprintln!("skipped (GLOFFUSE_SKIP_BROWSER_TESTS=1): {why}");
+    None
+}

@@ -1,0 +1,251 @@
+//! `report.html`: the verdict as a page a person reads in a browser, in the spirit of
+//! Blender's own render-test report: the verdict and its named thresholds first, the
+//! commands to rerun, then one row per sphere — failures first — with its numbers and three
+//! thumbnails (uncorrected, corrected, and the corrected sphere in false colour against what
+//! it promises). One self-contained file: the thumbnails are inline PNGs.
+
+use std::fmt::Write as _;
+
+use super::{deviation, png};
+use crate::verify::verdict::MIN_RING_PIXELS;
+use crate::verify::{Rendered, Role, VerifyReport};
+
+/// The colours of the verdict banner (the browser test looks for them).
+pub const PASS_COLOUR: &str = "#1b7a2f";
+pub const FAIL_COLOUR: &str = "#b3261e";
+
+/// `rerun` is the command line that reproduces the whole check (the CLI passes its own);
+/// `files` are the report's other files, linked by name.
+pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[String]) -> String {
+    let info = &report.render;
+    let failed = report.rows.iter().filter(|r| !r.pass).count();
+    let verdict = if report.pass { "PASS" } else { "FAIL" };
+    let banner = if report.pass {
+        PASS_COLOUR
+    } else {
+        FAIL_COLOUR
+    };
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>gloffuse verify: {verdict}</title>\n<style>\n\
+         body {{ font: 14px/1.4 sans-serif; margin: 0; color: #222; background: #fafafa; }}\n\
+         header {{ background: {banner}; color: white; padding: 16px 24px; }}\n\
+         header h1 {{ margin: 0 0 4px; font-size: 22px; }}\n\
+         main {{ padding: 8px 24px 32px; }}\n\
+         table {{ border-collapse: collapse; margin: 8px 0 20px; }}\n\
+         th, td {{ border-bottom: 1px solid #ddd; padding: 4px 10px; text-align: right; vertical-align: middle; }}\n\
+         th {{ background: #eee; }} td.name {{ text-align: left; }}\n\
+         tr.fail td {{ background: #fdecea; }}\n\
+         td.fail {{ color: {FAIL_COLOUR}; font-weight: bold; }} td.ok {{ color: {PASS_COLOUR}; }}\n\
+         img {{ image-rendering: pixelated; width: 96px; height: 96px; display: block; }}\n\
+         pre {{ background: #eee; padding: 6px 10px; white-space: pre-wrap; word-break: break-all; }}\n\
+         .scale {{ width: 320px; height: 14px; background: linear-gradient(to right, {}, {}, {}); }}\n\
+         </style></head><body>\n",
+        css(deviation::colour(-deviation::SCALE)),
+        css(deviation::colour(0.0)),
+        css(deviation::colour(deviation::SCALE)),
+    );
+    let _ = writeln!(
+        s,
+        "<header><h1>{verdict}: {} of {} corrected spheres as promised</h1>\
+         <div>Blender {} ({} masking) · coefficients {} · {} mode · colour {} ({}) · {} px per sphere, {} spp, seed {} · rendered in {:.1} s</div></header><main>",
+        report.rows.len() - failed,
+        report.rows.len(),
+        escape(&info.blender_version),
+        escape(&info.masking),
+        escape(&report.coefficients),
+        report.mode.key(),
+        report
+            .color
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        report.color_model.key(),
+        info.cell,
+        info.samples,
+        info.seed,
+        info.render_seconds,
+    );
+    let _ = writeln!(
+        s,
+        "<h2>Thresholds</h2><ul>\
+         <li><b>tolerance</b> (<code>--tolerance</code>): every channel of a corrected sphere's mean within ±{} % of what the correction promises.</li>\
+         <li><b>ring tolerance</b> (<code>--ring-tolerance</code>, view and multiscatter modes): every view-cosine ring with at least {MIN_RING_PIXELS} fully covered pixels within ±{} %.</li>\
+         <li>The false-colour thumbnails saturate at ±{} %.</li></ul>",
+        report.tolerance_percent,
+        report.ring_tolerance_percent,
+        100.0 * deviation::SCALE,
+    );
+    let _ = writeln!(
+        s,
+        "<h2>Rerun</h2><p>This check:</p><pre>{}</pre><p>Its Blender render (log: <code>{}</code>):</p><pre>{}</pre>",
+        escape(rerun),
+        escape(&info.log),
+        escape(&info.command)
+    );
+    if !report.notes.is_empty() {
+        s.push_str("<h2>Notes</h2><ul>");
+        for n in &report.notes {
+            let _ = write!(s, "<li>{}</li>", escape(n));
+        }
+        s.push_str("</ul>\n");
+    }
+    s.push_str(
+        "<h2>Spheres</h2><table><tr><th>status</th><th>sphere</th><th>uncorrected</th>\
+         <th>corrected</th><th>predicted</th><th>±SE</th><th>worst ring</th>\
+         <th>uncorrected</th><th>corrected</th><th>deviation</th></tr>\n",
+    );
+    let plan = &rendered.plan;
+    let cell = plan.settings.cell as usize;
+    let index_of = |role: Role, r: f64| {
+        plan.cells
+            .iter()
+            .position(|c| c.role == role && c.roughness == r)
+    };
+    let mut rows: Vec<_> = report.rows.iter().collect();
+    rows.sort_by_key(|r| r.pass);
+    for row in rows {
+        let thumb = |role: Role| {
+            index_of(role, row.roughness)
+                .map(|i| {
+                    png_tag(
+                        &png::cell_image(&rendered.image, plan.columns, cell, i),
+                        cell,
+                    )
+                })
+                .unwrap_or_default()
+        };
+        let false_colour = index_of(Role::Corrected(row.distribution), row.roughness)
+            .map(|i| png_tag(&deviation::cell_image(rendered, i, &row.ring_targets), cell))
+            .unwrap_or_default();
+        let (class, status) = if row.pass {
+            ("ok", "ok")
+        } else {
+            ("fail", "FAIL")
+        };
+        let _ = writeln!(
+            s,
+            "<tr class=\"{class}\"><td class=\"{class}\">{status}</td><td class=\"name\">{} r = {}</td>\
+             <td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td>\
+             <td>{}</td><td>{}</td><td>{false_colour}</td></tr>",
+            row.distribution.label(),
+            row.roughness,
+            100.0 * row.uncorrected_brightness,
+            100.0 * row.brightness,
+            100.0 * row.predicted_corrected,
+            100.0 * row.corrected.standard_error,
+            100.0 * row.worst_ring,
+            thumb(Role::Uncorrected(row.distribution)),
+            thumb(Role::Corrected(row.distribution)),
+        );
+    }
+    s.push_str("</table>\n");
+    let _ = writeln!(
+        s,
+        "<p>Deviation scale: <span style=\"display:inline-block;vertical-align:middle\" class=\"scale\"></span> \
+         −{0} % (darker) · 0 · +{0} % (brighter)</p>",
+        100.0 * deviation::SCALE
+    );
+    if !report.reference.is_empty() {
+        s.push_str(
+            "<h2>Reference: Blender's Multiscatter GGX</h2><table><tr><th>r</th><th>brightness</th><th>±SE</th><th>sphere</th></tr>\n",
+        );
+        for r in &report.reference {
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td>{:.2} %</td><td>{:.2} %</td><td>{}</td></tr>",
+                r.roughness,
+                100.0 * r.brightness,
+                100.0 * r.stats.standard_error,
+                index_of(Role::Reference, r.roughness)
+                    .map(|i| png_tag(
+                        &png::cell_image(&rendered.image, plan.columns, cell, i),
+                        cell
+                    ))
+                    .unwrap_or_default()
+            );
+        }
+        s.push_str("</table>\n");
+    }
+    if !files.is_empty() {
+        s.push_str("<h2>Files</h2><ul>");
+        for f in files {
+            let _ = write!(s, "<li><a href=\"{0}\">{0}</a></li>", escape(f));
+        }
+        s.push_str("</ul>\n");
+    }
+    s.push_str("</main></body></html>\n");
+    s
+}
+
+fn css([r, g, b]: [u8; 3]) -> String {
+    format!("rgb({r}, {g}, {b})")
+}
+
+/// An inline `<img>` of `cell × cell` RGB bytes.
+fn png_tag(rgb: &[u8], cell: usize) -> String {
+    match png::encode_png(rgb, (cell as u32, cell as u32)) {
+        Ok(bytes) => format!(
+            "<img alt=\"\" src=\"data:image/png;base64,{}\">",
+            base64(&bytes)
+        ),
+        Err(_) => String::new(),
+    }
+}
+
+/// Text for HTML: `&`, `<`, `>` and `"` escaped.
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// Standard base64 with padding (RFC 4648).
+fn base64(bytes: &[u8]) -> String {
+    const TABLE: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(TABLE[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_rfc_4648() {
+        for (text, encoded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(text.as_bytes()), encoded);
+        }
+        assert_eq!(
+            escape("<a href=\"x\">&</a>"),
+            "&lt;a href=&quot;x&quot;&gt;&amp;&lt;/a&gt;"
+        );
+    }
+}
