@@ -146,9 +146,11 @@ def set_tree_description(tree, text):
         tree.description = text
 
 
-def mark_asset(tree, description, tags):
+def mark_asset(tree, description, tags, asset=None):
     """Mark the group as an asset (Blender 3.0+) so it shows in the Asset
-    Browser, with a description and tags. Does nothing where unsupported."""
+    Browser, with a description and tags, and from `asset` (nodes.py's
+    asset_fields) its catalog, licence and copyright (those two from 3.6).
+    Does nothing where unsupported."""
     if not hasattr(tree, "asset_mark"):
         return False
     if getattr(tree, "asset_data", None) is None:
@@ -165,6 +167,9 @@ def mark_asset(tree, description, tags):
         for tag in tags:
             if tag not in present:
                 data.tags.new(tag, skip_if_exists=True)
+    for key, value in (asset or {}).items():
+        if value is not None and hasattr(data, key):
+            setattr(data, key, value)
     return True
 
 

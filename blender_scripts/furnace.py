@@ -289,13 +289,6 @@ def furnace_scene(furnace):
     return scene
 
 
-def render_result_image():
-    for image in bpy.data.images:
-        if image.type == "RENDER_RESULT":
-            return image
-    raise RuntimeError("rendering produced no Render Result image")
-
-
 def render_sweep(output):
     """Render the current scene once and save it to `output`; returns render seconds."""
     directory = os.path.dirname(output)

@@ -9,9 +9,12 @@
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
 # Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
 # params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# groups.py and runtime.py.
+# groups.py and runtime.py, and previews.py.
 # ---------------------------------------------------------------------------
 import sys  # also imported by runtime.py; repeated so this file reads on its own
+import tempfile
+
+import bpy
 
 
 def parse_generate_args(argv=None):
@@ -30,7 +33,14 @@ def generate_main():
     params = load_params(GLOFFUSE_PARAMS)  # noqa: F821 -- header; params.py
     if options.open:
         open_blend(options.open)  # noqa: F821 -- runtime.py
+    elif options.save and bpy.app.background:
+        # A new library file holds the groups and nothing else: not the startup
+        # file's cube, camera and light.
+        bpy.ops.wm.read_factory_settings(use_empty=True)
     built = build_all(params)  # noqa: F821 -- groups.py
+    if params.get("previews") and bpy.app.background:
+        with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
+            render_previews(built, params, directory)  # noqa: F821 -- previews.py
     saved = save_blend(options.save) if options.save else None  # noqa: F821 -- runtime.py
     names = []
     for _spec, trees in built:

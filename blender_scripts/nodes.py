@@ -297,3 +297,16 @@ class Chain:
         """when_zero + flag (when_one - when_zero) for floats; flag is 0 or 1."""
         difference = self.math("SUBTRACT", label + ": difference", when_one, when_zero)
         return self.math("MULTIPLY_ADD", label, difference, flag, when_zero)
+
+
+def asset_fields(params, kind):
+    """The asset fields of a group of `kind` ("shader" for the groups with a
+    BSDF output, "helper" for the others): its catalog (so that Blender 4.0+
+    lists shader groups in Add > Shader, helpers in a sub-menu) and the
+    licence and copyright of the parameter document."""
+    catalog = (params.get("catalogs") or {}).get(kind) or {}
+    return {
+        "catalog_id": catalog.get("uuid"),
+        "license": params.get("asset_license"),
+        "copyright": params.get("asset_copyright"),
+    }

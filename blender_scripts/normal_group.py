@@ -158,7 +158,7 @@ def build_normal_group(params):
         "Blender %s." % (rule, ", honouring Bump Map Correction" if has_bump_map_correction() else "",
                          params.get("gloffuse_version", "?"), blender_version_string()))
     set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", "normal"])
+    mark_asset(tree, description, ["gloffuse", "normal"], asset_fields(params, "helper"))
     return tree
 
 

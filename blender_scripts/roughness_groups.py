@@ -186,7 +186,8 @@ def build_correction_group(spec, params):
 
     description = group_description(spec, params, "correction")
     set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", spec["distribution"]])
+    mark_asset(tree, description, ["gloffuse", spec["distribution"]],
+               asset_fields(params, "helper"))
     return tree
 
 
@@ -194,11 +195,11 @@ def build_shader_group(spec, params, correction_tree):
     """The group Color, Roughness, Normal -> BSDF: a Glossy BSDF whose colour
     goes through the correction group."""
     description = group_description(spec, params, "shader")
-    return build_glossy_group(spec["shader_group"], spec, correction_tree, description,
+    return build_glossy_group(spec["shader_group"], spec, params, correction_tree, description,
                               ["gloffuse", spec["distribution"]])
 
 
-def build_glossy_group(name, spec, correction_tree, description, tags, sockets=None):
+def build_glossy_group(name, spec, params, correction_tree, description, tags, sockets=None):
     """Color, Roughness, Normal -> BSDF: a Glossy BSDF of the spec's distribution
     whose colour goes through `correction_tree` (roughness-only or view; every
     input the two share is passed on)."""
@@ -236,5 +237,5 @@ def build_glossy_group(name, spec, correction_tree, description, tags, sockets=N
     links.new(glossy.outputs[0], group_out.inputs["BSDF"])
 
     set_tree_description(tree, description)
-    mark_asset(tree, description, tags)
+    mark_asset(tree, description, tags, asset_fields(params, "shader"))
     return tree

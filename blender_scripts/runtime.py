@@ -118,3 +118,11 @@ def run_main(main):
             sys.stdout.flush()
             sys.exit(1)
         raise
+
+
+def render_result_image():
+    """The Render Result image of the last render (furnace.py, previews.py)."""
+    for image in bpy.data.images:
+        if image.type == "RENDER_RESULT":
+            return image
+    raise RuntimeError("rendering produced no Render Result image")

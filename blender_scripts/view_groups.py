@@ -188,7 +188,8 @@ def build_view_correction_group(spec, params):
         "evenly lit white surface is 100 %%. %s"
         % (spec["distribution"], params["normal_group"], view["image"], colour)))
     set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", spec["distribution"], "view"])
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "view"],
+               asset_fields(params, "helper"))
     return tree
 
 
@@ -197,7 +198,8 @@ def build_view_shader_group(spec, params, correction_tree):
     description = description_text(spec, params, (
         "Glossy BSDF (%s) whose colour is multiplied by the view-dependent gain of '%s'."
         % (spec["distribution"], correction_tree.name)))
-    return build_glossy_group(spec["view"]["shader_group"], spec, correction_tree, description,
+    return build_glossy_group(spec["view"]["shader_group"], spec, params, correction_tree,
+                              description,
                               ["gloffuse", spec["distribution"], "view"],
                               view_shader_sockets("Brightness-corrected glossy BSDF"))
 
@@ -268,5 +270,6 @@ def build_multiscatter_group(spec, params):
            "Color × Fms × (1 - E(mu, r)), Fms = C E_avg / (1 - C (1 - E_avg)) (physical colour)"
            if physical else "Color × (1 - E(mu, r))", params["normal_group"])))
     set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", spec["distribution"], "multiscatter"])
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "multiscatter"],
+               asset_fields(params, "shader"))
     return tree

@@ -531,5 +531,8 @@ echo 'GLOFFUSE_RESULT {"blender_version": "4.5.0", "groups": [], "saved": "x"}'"
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     left.sort();
-    assert_eq!(left, ["library ü.blend", "library ü.py"]);
+    assert_eq!(
+        left,
+        ["blender_assets.cats.txt", "library ü.blend", "library ü.py"]
+    );
 }

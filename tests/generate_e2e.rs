@@ -29,6 +29,39 @@ fn expectations(preset: &str) -> Value {
     json!({ "groups": groups })
 }
 
+/// A catalog file as a user might have it: their own `Shader` catalog and another one.
+const USER_CATALOGS: &str = "VERSION 1\n\n# my studio's catalogs\n\
+     0e5a7f27-7e0e-4a11-9a35-1f4b2a7c9d01:Shader:My shaders\n\
+     1b2c3d4e-0000-4000-8000-000000000001:Props/Chairs:Props-Chairs\n";
+
+/// `tests/blender/check_assets.py` on a generated library: catalogs from the file beside
+/// it, real previews, licence, and nothing but the groups in it.
+fn check_assets(label: &str, blender: &std::path::Path, blend: &std::path::Path) {
+    let checker = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/blender/check_assets.py");
+    let dir = tempfile::tempdir().unwrap();
+    let result = dir.path().join("assets.json");
+    let run = common::blender::run_in_blender(
+        blender,
+        checker.as_ref(),
+        &[
+            "--blend".as_ref(),
+            blend.as_os_str(),
+            "--out".as_ref(),
+            result.as_os_str(),
+        ],
+    );
+    let report: Value = std::fs::read_to_string(&result)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(Value::Null);
+    assert!(
+        run.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
+        "Blender {label}: check_assets failed\nfailures: {}\nstderr:\n{}",
+        report["failures"],
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
 #[test]
 fn generated_blend_works_in_every_blender() {
     let checker = concat!(
@@ -41,13 +74,24 @@ fn generated_blend_works_in_every_blender() {
         std::fs::create_dir(&sub).unwrap();
         let blend = sub.join("gloffuse library.blend");
         let script = sub.join("gen erate.py");
+        // The user's own catalogs: kept, and their "Shader" catalog is the one used.
+        let cats = sub.join("blender_assets.cats.txt");
+        std::fs::write(&cats, USER_CATALOGS).unwrap();
         let preset = if label == "3.4" {
             "blender-3"
         } else {
             "blender-4"
         };
         let out = common::gloffuse()
-            .args(["generate", "--json", "--blend"])
+            .args([
+                "generate",
+                "--json",
+                "--mode",
+                "roughness",
+                "--mode",
+                "view",
+            ])
+            .args(["--mode", "multiscatter", "--blend"])
             .arg(&blend)
             .arg("--script")
             .arg(&script)
@@ -69,9 +113,15 @@ fn generated_blend_works_in_every_blender() {
             .collect();
         assert_eq!(
             leftovers.len(),
-            2,
-            "Blender {label}: only the .blend and the script: {leftovers:?}"
+            3,
+            "Blender {label}: only the .blend, its catalogs and the script: {leftovers:?}"
         );
+        let merged = std::fs::read_to_string(&cats).unwrap();
+        assert!(
+            merged.starts_with(USER_CATALOGS) && merged.matches(":Shader:").count() == 1,
+            "Blender {label}: the user's catalogs are kept as they are:\n{merged}"
+        );
+        check_assets(label, &blender, &blend);
 
         let expect = dir.path().join("expect.json");
         std::fs::write(&expect, expectations(preset).to_string()).unwrap();

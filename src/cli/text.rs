@@ -26,6 +26,9 @@ pub fn generated(out: &Generated) -> String {
     if let Some(p) = &out.backup {
         let _ = writeln!(s, "backup: {}", p.display());
     }
+    if let Some(p) = &out.catalogs {
+        let _ = writeln!(s, "catalogs: {}", p.display());
+    }
     let _ = writeln!(s, "coefficients: {}", out.coefficients);
     let _ = writeln!(s, "groups: {}", out.groups.join(", "));
     s

@@ -3,6 +3,7 @@
 //! Blender wrote.
 
 pub mod blend;
+pub mod catalogs;
 pub mod params;
 pub mod script;
 
@@ -62,6 +63,8 @@ pub struct Generated {
     pub script: Option<PathBuf>,
     pub blend: Option<PathBuf>,
     pub backup: Option<PathBuf>,
+    /// The catalog definition file written (merged) beside a new .blend.
+    pub catalogs: Option<PathBuf>,
     pub groups: Vec<String>,
     pub log: Option<PathBuf>,
 }
@@ -113,7 +116,31 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         Some((coefficients, name)) => Curves::Pinned { coefficients, name },
         None => Curves::Presets,
     };
-    let params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
+    let mut params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
+    // A new library .blend gets previews and the catalogs of the definition file beside
+    // it (the user's own catalog for one of our paths wins); `--into` keeps the user's file
+    // as it is apart from the groups, and a script leaves both to the Blender it runs in.
+    let catalogs_file = match &g.blend {
+        Some(blend) => catalogs_beside(blend)?,
+        None => None,
+    };
+    let mut catalogs_text = None;
+    if let Some(file) = &catalogs_file {
+        let existing = match std::fs::read_to_string(file) {
+            Ok(text) => Some(text),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(source) => {
+                return Err(Error::Read {
+                    path: file.clone(),
+                    source,
+                });
+            }
+        };
+        let (merged, text) = params.catalogs.merge(existing.as_deref());
+        params.catalogs = merged;
+        params.previews = true;
+        catalogs_text = Some(text);
+    }
     let script = assemble(&params, Job::Generate);
     let mut out = Generated {
         blender: blender.as_ref().map(|b| b.version_string.clone()),
@@ -129,6 +156,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         script: None,
         blend: None,
         backup: None,
+        catalogs: None,
         groups: params.group_names(),
         log: None,
     };
@@ -207,7 +235,23 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
             write_output(&dest, &bytes)?;
         }
     }
+    if let (Some(file), Some(text)) = (&catalogs_file, &catalogs_text) {
+        write_output(file, text.as_bytes())?;
+        out.catalogs = Some(file.clone());
+    }
     out.blend = Some(dest);
     out.log = Some(log);
     Ok(out)
+}
+
+/// Where the catalog definition file of the library `blend` lives: beside the file it
+/// really is (through a symlink); none for a stream, which has no folder.
+fn catalogs_beside(blend: &std::path::Path) -> Result<Option<PathBuf>, Error> {
+    Ok(match check_destination(blend)? {
+        Destination::File(real) => {
+            let folder = real.parent().unwrap_or(std::path::Path::new("."));
+            Some(folder.join(catalogs::FILE_NAME))
+        }
+        Destination::Stream(_) | Destination::Stdout => None,
+    })
 }

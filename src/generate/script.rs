@@ -52,10 +52,16 @@ impl Job {
     /// The job's parts after [`PARTS`], its main last.
     pub fn parts(self) -> Vec<(&'static str, &'static str)> {
         match self {
-            Job::Generate => vec![(
-                "generate_main.py",
-                include_str!("../../blender_scripts/generate_main.py"),
-            )],
+            Job::Generate => vec![
+                (
+                    "previews.py",
+                    include_str!("../../blender_scripts/previews.py"),
+                ),
+                (
+                    "generate_main.py",
+                    include_str!("../../blender_scripts/generate_main.py"),
+                ),
+            ],
             Job::Furnace => vec![
                 FURNACE_PART,
                 (
