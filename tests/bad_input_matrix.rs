@@ -335,8 +335,33 @@ fn cases() -> Vec<Case> {
         // --- generate -----------------------------------------------------------------
         case(&["generate"]).no_blender().says(&[
             "(no output)",
-            "--script OUT.py, --blend OUT.blend or --into EXISTING.blend",
+            "--script OUT.py, --blend OUT.blend, --into EXISTING.blend or --extension OUT.zip",
         ]),
+        case(&["generate", "--extension", "@/gloffuse.tar"])
+            .no_blender()
+            .says(&[
+                "invalid --extension '@/gloffuse.tar'",
+                "a file name ending in .zip",
+            ])
+            .writes_nothing_to(&["@/gloffuse.tar"]),
+        case(&[
+            "generate",
+            "--extension",
+            "@/g.zip",
+            "--into",
+            "@/scene.blend",
+        ])
+        .no_blender()
+        .file("scene.blend", "BLENDER-v405")
+        .says(&["'--extension <OUT.zip>' cannot be used with '--into <EXISTING.blend>'"])
+        .writes_nothing_to(&["@/g.zip", "@/scene.blend1"]),
+        case(&["generate", "--extension", "@/no dir/g.zip"])
+            .no_blender()
+            .says(&[
+                "cannot write @/no dir/g.zip",
+                "the directory @/no dir does not exist",
+            ])
+            .writes_nothing_to(&["@/no dir/g.zip"]),
         case(&["generate", "--script", "@/no dir/g.py"])
             .says(&[
                 "cannot write @/no dir/g.py",

@@ -190,11 +190,110 @@ fn into_replaces_groups_in_place_and_keeps_a_backup() {
         first,
         "the .blend1 holds the previous file"
     );
-    let names: Vec<_> = std::fs::read_dir(dir.path())
+    let mut names: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
-    assert_eq!(names.len(), 2, "{names:?}");
+    names.sort();
+    assert_eq!(
+        names,
+        ["blender_assets.cats.txt", "scene.blend", "scene.blend1"]
+    );
+}
+
+/// The extension built in bpy 4.5: Blender's validator accepts it, and in bpy 4.5 and 5.0
+/// it installs, enables, registers its library with the generated groups, and cleans up
+/// on disable (tests/blender/check_extension.py, in a fresh user-resources folder).
+#[test]
+fn the_extension_installs_and_brings_the_groups() {
+    let Some(builder) = common::blender::real_blender("4.5") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let zip = dir.path().join("gloffuse.zip");
+    let out = common::gloffuse()
+        .args([
+            "generate",
+            "--json",
+            "--mode",
+            "roughness,view,multiscatter",
+        ])
+        .arg("--extension")
+        .arg(&zip)
+        .arg("--blender")
+        .arg(&builder)
+        .args(["--no-provision", "--timeout", "300"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let summary: Value = serde_json::from_slice(&out).unwrap();
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(leftovers.len(), 1, "only the .zip: {leftovers:?}");
+    let groups = dir.path().join("groups.json");
+    std::fs::write(&groups, summary["groups"].to_string()).unwrap();
+    let checker = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/blender/check_extension.py"
+    );
+    for label in ["4.5", "5.0"] {
+        let Some(blender) = common::blender::real_blender(label) else {
+            continue;
+        };
+        let user = tempfile::tempdir().unwrap();
+        let result = dir.path().join(format!("extension {label}.json"));
+        let run = common::blender::run_in_blender(
+            &blender,
+            checker.as_ref(),
+            &[
+                "--zip".as_ref(),
+                zip.as_os_str(),
+                "--groups".as_ref(),
+                groups.as_os_str(),
+                "--user-resources".as_ref(),
+                user.path().as_os_str(),
+                "--out".as_ref(),
+                result.as_os_str(),
+            ],
+        );
+        let report: Value = std::fs::read_to_string(&result)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or(Value::Null);
+        assert!(
+            run.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
+            "Blender {label}: check_extension failed\nfailures: {}\nstderr:\n{}",
+            report["failures"],
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert_eq!(
+            report["assets"].as_array().map(Vec::len),
+            summary["groups"].as_array().map(Vec::len)
+        );
+    }
+}
+
+/// An extension needs a Blender with extensions to build it: 3.4 is refused before it runs,
+/// naming what would work, and nothing is written.
+#[test]
+fn blender_3_4_cannot_build_an_extension() {
+    let Some(blender) = common::blender::real_blender("3.4") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let zip = dir.path().join("gloffuse.zip");
+    common::gloffuse()
+        .args(["generate", "--extension"])
+        .arg(&zip)
+        .arg("--blender")
+        .arg(&blender)
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains(
+            "Blender 4.2 or later for --extension",
+        ));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
 /// One script, written without any Blender, run in Blender 3.4, 4.5 and 5.0: each builds

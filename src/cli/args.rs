@@ -31,6 +31,14 @@ looked and how to point at one), Blender failed or timed out (the message quotes
 names the log file and prints the command to rerun it), or an output could not be written \
 (nothing half-written is ever left behind).";
 
+const GENERATE_EXAMPLES: &str = "\
+Examples:
+  gloffuse generate --extension gloffuse.zip     an extension to install in Blender 4.2+
+  gloffuse generate --blend lib/gloffuse.blend --mode roughness,view
+                                                 a library .blend with the view groups too
+  gloffuse generate --into scene.blend           update the groups in your file, in place
+  gloffuse generate --script gloffuse.py         a script for Blender's Text Editor";
+
 #[derive(Parser, Debug)]
 #[command(name = "gloffuse", version, about = ABOUT, long_about = LONG_ABOUT)]
 pub struct Cli {
@@ -52,12 +60,14 @@ pub enum Command {
     /// distributions from the integrator (--from integrator) into a coefficients file. The
     /// shader gain that restores 100 % is 100/f(r).
     Fit(FitArgs),
-    /// Write the brightness-correction node groups: a Python script, a new .blend, or into a .blend.
+    /// Write the brightness-correction node groups: a script, a .blend, or a Blender extension.
     ///
     /// Builds `Brightness Correction (…)` (gain = 100/f(r)) and `Gloffuse (…)` (a Glossy BSDF
-    /// driven by the corrected colour) for each distribution in the coefficients. --script
-    /// needs no Blender; --blend and --into run Blender headless (found or installed
-    /// automatically, see --blender).
+    /// driven by the corrected colour) for each distribution in the coefficients, and with
+    /// --mode the view and multiscatter groups. --script needs no Blender; --blend, --into
+    /// and --extension run Blender headless (found or installed automatically, see
+    /// --blender).
+    #[command(after_long_help = GENERATE_EXAMPLES)]
     Generate(GenerateArgs),
     /// Render furnace spheres in Blender and check that corrected ones come out at 100 %.
     ///
@@ -465,7 +475,9 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "OUT.py")]
     pub script: Option<PathBuf>,
 
-    /// Write a new .blend library holding the groups (marked as assets).
+    /// Write a new .blend library holding the groups, as assets with previews, and its
+    /// catalog file beside it (blender_assets.cats.txt, merged into an existing one): mark
+    /// the folder as an asset library in Preferences ▸ File Paths, or File ▸ Append.
     #[arg(long, value_name = "OUT.blend", conflicts_with = "into")]
     pub blend: Option<PathBuf>,
 
@@ -473,6 +485,14 @@ pub struct GenerateArgs {
     /// working); the previous file is kept as FILE.blend1.
     #[arg(long, value_name = "EXISTING.blend")]
     pub into: Option<PathBuf>,
+
+    /// Write a Blender extension (4.2+): drag the .zip into Blender, or Edit ▸ Preferences ▸
+    /// Get Extensions ▸ Install from Disk. Enabling it registers the library as the asset
+    /// library "Gloffuse", so the groups show in the Asset Browser and in the shader
+    /// editor's Add ▸ Shader menu. Needs a Blender 4.2 or later to build; it runs in that
+    /// version and later.
+    #[arg(long, value_name = "OUT.zip", conflicts_with = "into")]
+    pub extension: Option<PathBuf>,
 
     /// Which groups to build besides the roughness-only pair (repeatable): view adds
     /// `Brightness Correction View (…)` and `Gloffuse View (…)` (gain 1/E(μ, r)), and
@@ -500,6 +520,7 @@ impl GenerateArgs {
             script: self.script.clone(),
             blend: self.blend.clone(),
             into: self.into.clone(),
+            extension: self.extension.clone(),
             modes: self.mode.clone(),
             color_model: self.color_model,
             blender: self.blender.options(false),

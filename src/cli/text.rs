@@ -29,6 +29,9 @@ pub fn generated(out: &Generated) -> String {
     if let Some(p) = &out.catalogs {
         let _ = writeln!(s, "catalogs: {}", p.display());
     }
+    if let Some(p) = &out.extension {
+        let _ = writeln!(s, "extension: {}", p.display());
+    }
     let _ = writeln!(s, "coefficients: {}", out.coefficients);
     let _ = writeln!(s, "groups: {}", out.groups.join(", "));
     s

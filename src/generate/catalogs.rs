@@ -32,6 +32,11 @@ impl Catalog {
             simple_name: path.replace('/', "-"),
         }
     }
+
+    /// Its line in a definition file.
+    fn line(&self) -> String {
+        format!("{}:{}:{}\n", self.uuid, self.path, self.simple_name)
+    }
 }
 
 /// The catalogs of the two kinds of group.
@@ -78,12 +83,7 @@ impl Catalogs {
                 }
                 t
             }
-            _ => "# This is an Asset Catalog Definition file for Blender.\n#\n\
-                  # Empty lines and lines starting with `#` will be ignored.\n\
-                  # The first non-ignored line should be the version indicator.\n\
-                  # Other lines are of the format \"UUID:catalog/path/for/assets:simple catalog name\"\n\n\
-                  VERSION 1\n\n"
-                .to_string(),
+            _ => HEADER.to_string(),
         };
         let mut resolve = |ours: &Catalog| match lines.iter().find(|(_, path)| *path == ours.path) {
             Some((uuid, _)) => Catalog {
@@ -102,7 +102,23 @@ impl Catalogs {
         let helper = resolve(&self.helper);
         (Catalogs { shader, helper }, text)
     }
+
+    /// A definition file of these catalogs alone (the one an extension bundles).
+    pub fn definition_file(&self) -> String {
+        let mut text = HEADER.to_string();
+        for c in [&self.shader, &self.helper] {
+            text.push_str(&c.line());
+        }
+        text
+    }
 }
+
+/// The opening of a new definition file, as Blender writes it.
+const HEADER: &str = "# This is an Asset Catalog Definition file for Blender.\n#\n\
+    # Empty lines and lines starting with `#` will be ignored.\n\
+    # The first non-ignored line should be the version indicator.\n\
+    # Other lines are of the format \"UUID:catalog/path/for/assets:simple catalog name\"\n\n\
+    VERSION 1\n\n";
 
 #[cfg(test)]
 mod tests {
@@ -122,6 +138,7 @@ mod tests {
         let ours = Catalogs::default();
         let (fresh, text) = ours.merge(None);
         assert_eq!(fresh, ours);
+        assert_eq!(text, ours.definition_file());
         assert!(text.contains("\nVERSION 1\n"));
         assert!(text.contains(&format!("{}:Shader:Shader\n", ours.shader.uuid)));
         // Merging again adds nothing.

@@ -4,6 +4,7 @@
 
 pub mod blend;
 pub mod catalogs;
+pub mod extension;
 pub mod params;
 pub mod script;
 
@@ -35,6 +36,8 @@ pub struct GenerateOptions {
     pub blend: Option<PathBuf>,
     /// Add or replace the groups in this existing .blend, in place (keeping a .blend1).
     pub into: Option<PathBuf>,
+    /// Write a Blender extension (.zip) that installs the library as an asset library.
+    pub extension: Option<PathBuf>,
     /// Which groups to build besides the roughness-only pair.
     pub modes: Vec<Mode>,
     pub color_model: ColorModel,
@@ -48,6 +51,7 @@ impl Default for GenerateOptions {
             script: None,
             blend: None,
             into: None,
+            extension: None,
             modes: vec![Mode::Roughness],
             color_model: ColorModel::Exact,
             blender: BlenderOptions::default(),
@@ -65,17 +69,21 @@ pub struct Generated {
     pub backup: Option<PathBuf>,
     /// The catalog definition file written (merged) beside a new .blend.
     pub catalogs: Option<PathBuf>,
+    pub extension: Option<PathBuf>,
     pub groups: Vec<String>,
     pub log: Option<PathBuf>,
 }
 
-/// Writes what `g` asks for; nothing is written if anything fails.
-pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
-    if g.script.is_none() && g.blend.is_none() && g.into.is_none() {
+/// Refuses what cannot work before anything is looked for or written.
+fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
+    if [&g.script, &g.blend, &g.into, &g.extension]
+        .iter()
+        .all(|o| o.is_none())
+    {
         return Err(Error::input(
             "arguments",
             "(no output)",
-            "--script OUT.py, --blend OUT.blend or --into EXISTING.blend",
+            "--script OUT.py, --blend OUT.blend, --into EXISTING.blend or --extension OUT.zip",
         ));
     }
     if let Some(into) = &g.into {
@@ -93,20 +101,54 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
                 expected,
             ));
         }
+        if g.blend.is_some() || g.extension.is_some() {
+            return Err(Error::input(
+                "--into",
+                &into.display().to_string(),
+                "--into alone (with --script at most): --blend and --extension make a new \
+                 library, --into changes your file in place",
+            ));
+        }
     }
-    // Outputs are checked before Blender is looked for: bad input fails fast.
-    for out in [&g.blend, &g.script].into_iter().flatten() {
+    if let Some(zip) = &g.extension {
+        let named_zip = zip
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("zip"));
+        if !named_zip
+            && !matches!(
+                check_destination(zip)?,
+                Destination::Stream(_) | Destination::Stdout
+            )
+        {
+            return Err(Error::input(
+                "--extension",
+                &zip.display().to_string(),
+                "a file name ending in .zip (Blender installs extensions from a .zip)",
+            ));
+        }
+    }
+    for out in [&g.blend, &g.script, &g.extension].into_iter().flatten() {
         check_destination(out)?;
     }
-    let needs_blender = g.blend.is_some() || g.into.is_some();
-    // Coefficients are checked before Blender is looked for: bad input fails fast.
+    Ok(())
+}
+
+/// Writes what `g` asks for; nothing is written if anything fails.
+pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
+    // Inputs and coefficients are checked before Blender is looked for: bad input fails fast.
+    check_inputs(g)?;
     let pinned = g
         .coefficients
         .as_deref()
         .map(|name| Coefficients::load(name).map(|c| (c, name)))
         .transpose()?;
+    let needs_blender = g.blend.is_some() || g.into.is_some() || g.extension.is_some();
     let blender = if needs_blender {
-        Some(g.blender.find(progress)?)
+        let blender = g.blender.find(progress)?;
+        if g.extension.is_some() {
+            extension::can_build(blender.version)?;
+        }
+        Some(blender)
     } else {
         None
     };
@@ -117,9 +159,10 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         None => Curves::Presets,
     };
     let mut params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
-    // A new library .blend gets previews and the catalogs of the definition file beside
-    // it (the user's own catalog for one of our paths wins); `--into` keeps the user's file
-    // as it is apart from the groups, and a script leaves both to the Blender it runs in.
+    // A new library (.blend or extension) gets previews, and the catalogs of the
+    // definition file beside the .blend (the user's own catalog for one of our paths wins);
+    // `--into` keeps the user's file as it is apart from the groups, and a script leaves
+    // both to the Blender it runs in.
     let catalogs_file = match &g.blend {
         Some(blend) => catalogs_beside(blend)?,
         None => None,
@@ -138,9 +181,9 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         };
         let (merged, text) = params.catalogs.merge(existing.as_deref());
         params.catalogs = merged;
-        params.previews = true;
         catalogs_text = Some(text);
     }
+    params.previews = g.blend.is_some() || g.extension.is_some();
     let script = assemble(&params, Job::Generate);
     let mut out = Generated {
         blender: blender.as_ref().map(|b| b.version_string.clone()),
@@ -157,6 +200,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         blend: None,
         backup: None,
         catalogs: None,
+        extension: None,
         groups: params.group_names(),
         log: None,
     };
@@ -171,14 +215,13 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     let run_dir = crate::blender::runs::new_run_dir("generate")?;
     let script_path = run_dir.join("gloffuse-generate.py");
     write_output(&script_path, script.as_bytes())?;
-    let dest = g
-        .blend
-        .clone()
-        .or_else(|| g.into.clone())
-        .expect("needs_blender");
     // Blender saves beside the file it replaces (relative paths in the .blend stay
-    // right), or, for a stream, in the run folder.
-    let target = check_destination(&dest)?;
+    // right), or, for a stream or an extension alone, in the run folder.
+    let dest = g.blend.clone().or_else(|| g.into.clone());
+    let target = match &dest {
+        Some(dest) => check_destination(dest)?,
+        None => Destination::Stream(run_dir.join(extension::LIBRARY_FILE)),
+    };
     let tmp = match &target {
         Destination::File(real) => temp_beside(real, ".blend")?,
         Destination::Stream(_) | Destination::Stdout => {
@@ -206,11 +249,30 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
             command: Some(command_line(&run)),
         });
     }
-    // Only now, with the .blend made, the script: a failed run leaves no output at all.
+    out.log = Some(log);
+    // Everything is made before anything is written: a failed run leaves no output at all.
+    let package = match &g.extension {
+        Some(_) => {
+            let blend = std::fs::read(&tmp).map_err(|source| Error::Read {
+                path: tmp.to_path_buf(),
+                source,
+            })?;
+            let catalogs = params.catalogs.definition_file();
+            Some(extension::package(&blend, &catalogs, blender.version)?)
+        }
+        None => None,
+    };
     if let Some(path) = &g.script {
         write_output(path, script.as_bytes())?;
         out.script = Some(path.clone());
     }
+    if let (Some(zip), Some(bytes)) = (&g.extension, &package) {
+        write_output(zip, bytes)?;
+        out.extension = Some(zip.clone());
+    }
+    let Some(dest) = dest else {
+        return Ok(out);
+    };
     if let (Some(_), Destination::File(real)) = (&g.into, &target) {
         // Blender's own convention: the previous version stays beside the file as .blend1.
         let mut backup = real.clone().into_os_string();
@@ -240,7 +302,6 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         out.catalogs = Some(file.clone());
     }
     out.blend = Some(dest);
-    out.log = Some(log);
     Ok(out)
 }
 

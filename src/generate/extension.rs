@@ -1,0 +1,146 @@
+//! The Blender extension (4.2+): a .zip Blender installs from disk, holding
+//! `blender_manifest.toml`, a small add-on (GPL-3.0-or-later) that registers the bundled
+//! library as an asset library when enabled and removes it when disabled, and the library
+//! itself (the .blend of CC0 node groups and its catalog file).
+
+use std::io::{Cursor, Write};
+
+use zip::write::SimpleFileOptions;
+use zip::{CompressionMethod, DateTime, ZipWriter};
+
+use crate::Error;
+use crate::measure::BlenderVersion;
+
+/// The first Blender with extensions.
+pub const FIRST_BLENDER: BlenderVersion = BlenderVersion { major: 4, minor: 2 };
+
+/// The extension's id: its Python package is `bl_ext.<repository>.gloffuse`.
+pub const ID: &str = "gloffuse";
+
+/// Where the library sits inside the extension (the add-on reads it from there).
+pub const LIBRARY_FOLDER: &str = "library";
+pub const LIBRARY_FILE: &str = "gloffuse.blend";
+
+const ADDON: &str = include_str!("../../blender_scripts/extension/__init__.py");
+const LICENSE: &str = include_str!("../../LICENSE");
+
+/// The manifest. `blender_version_min` is the Blender that saved the library: an older one
+/// may not read the file (5.0's .blend format is new) or its node sockets.
+pub fn manifest(built_with: BlenderVersion) -> String {
+    format!(
+        r#"schema_version = "1.0.0"
+
+id = "{ID}"
+version = "{version}"
+name = "Gloffuse"
+tagline = "Glossy node groups that keep their brightness at any roughness"
+maintainer = "The gloffuse authors"
+type = "add-on"
+tags = ["Material", "Node"]
+
+blender_version_min = "{major}.{minor}.0"
+
+# The add-on's code; the node groups it bundles are CC0-1.0 (see each asset's licence).
+license = ["SPDX:GPL-3.0-or-later"]
+copyright = ["2026 The gloffuse authors"]
+"#,
+        version = env!("CARGO_PKG_VERSION"),
+        major = built_with.major,
+        minor = built_with.minor,
+    )
+}
+
+/// Refuses a Blender before 4.2: no extension system, and the library the extension packs
+/// is saved by the Blender that builds it.
+pub fn can_build(built_with: BlenderVersion) -> Result<(), Error> {
+    if built_with < FIRST_BLENDER {
+        return Err(Error::input(
+            "--blender",
+            &format!("Blender {}.{}", built_with.major, built_with.minor),
+            "Blender 4.2 or later for --extension (extensions came with 4.2, and the \
+             library it packs is saved by the Blender that builds it)",
+        ));
+    }
+    Ok(())
+}
+
+/// The extension's .zip, from the library .blend and its catalog file, built by Blender
+/// `built_with` (4.2 or later). Entries are stored with a fixed date, so the same inputs
+/// give the same bytes.
+pub fn package(blend: &[u8], catalogs: &str, built_with: BlenderVersion) -> Result<Vec<u8>, Error> {
+    can_build(built_with)?;
+    let manifest = manifest(built_with);
+    let files: [(String, &[u8]); 5] = [
+        ("blender_manifest.toml".into(), manifest.as_bytes()),
+        ("__init__.py".into(), ADDON.as_bytes()),
+        ("LICENSE".into(), LICENSE.as_bytes()),
+        (format!("{LIBRARY_FOLDER}/{LIBRARY_FILE}"), blend),
+        (
+            format!("{LIBRARY_FOLDER}/{}", super::catalogs::FILE_NAME),
+            catalogs.as_bytes(),
+        ),
+    ];
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    let options = SimpleFileOptions::default()
+        .compression_method(CompressionMethod::Deflated)
+        .last_modified_time(DateTime::default())
+        .unix_permissions(0o644);
+    let failed = |e: &dyn std::fmt::Display| Error::Write {
+        path: "(the extension archive, in memory)".into(),
+        message: e.to_string(),
+    };
+    for (name, bytes) in files {
+        zip.start_file(name, options).map_err(|e| failed(&e))?;
+        zip.write_all(bytes).map_err(|e| failed(&e))?;
+    }
+    Ok(zip.finish().map_err(|e| failed(&e))?.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Read;
+
+    #[test]
+    fn the_archive_holds_the_manifest_addon_and_library() {
+        let v45 = BlenderVersion { major: 4, minor: 5 };
+        let bytes = package(b"BLENDER-fake", "VERSION 1\n", v45).unwrap();
+        assert_eq!(bytes, package(b"BLENDER-fake", "VERSION 1\n", v45).unwrap());
+        let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+        let mut names: Vec<String> = archive
+            .file_names()
+            .map(|n| n.unwrap().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "LICENSE",
+                "__init__.py",
+                "blender_manifest.toml",
+                "library/blender_assets.cats.txt",
+                "library/gloffuse.blend"
+            ]
+        );
+        let mut manifest = String::new();
+        archive
+            .by_name("blender_manifest.toml")
+            .unwrap()
+            .read_to_string(&mut manifest)
+            .unwrap();
+        assert!(manifest.contains("\nblender_version_min = \"4.5.0\"\n"));
+        let mut blend = Vec::new();
+        archive
+            .by_name("library/gloffuse.blend")
+            .unwrap()
+            .read_to_end(&mut blend)
+            .unwrap();
+        assert_eq!(blend, b"BLENDER-fake");
+    }
+
+    #[test]
+    fn blender_before_4_2_cannot_build_one() {
+        let err = package(b"", "", BlenderVersion { major: 3, minor: 4 }).unwrap_err();
+        assert!(err.to_string().contains("4.2 or later"), "{err}");
+    }
+}
