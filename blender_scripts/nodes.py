@@ -303,10 +303,11 @@ def asset_fields(params, kind):
     """The asset fields of a group of `kind` ("shader" for the groups with a
     BSDF output, "helper" for the others): its catalog (so that Blender 4.0+
     lists shader groups in Add > Shader, helpers in a sub-menu) and the
-    licence and copyright of the parameter document."""
+    author, licence and copyright of the parameter document."""
     catalog = (params.get("catalogs") or {}).get(kind) or {}
     return {
         "catalog_id": catalog.get("uuid"),
+        "author": params.get("asset_author"),
         "license": params.get("asset_license"),
         "copyright": params.get("asset_copyright"),
     }

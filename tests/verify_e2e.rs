@@ -106,6 +106,16 @@ fn seed_coefficients_fail_and_say_why() {
     let text = String::from_utf8_lossy(&out);
     assert!(text.contains("FAIL"), "{text}");
     assert!(text.contains("display-referred"), "{text}");
+    // Both ways: at r = 0.4 the seed's GGX gain 100/f = 100/89.79 times E_avg = 0.9405 is
+    // 104.7 %; at r = 1 it is 69 %.
+    assert!(
+        text.contains("Over-corrected:") && text.contains("worst GGX r = 0.4 at 104.7 %"),
+        "{text}"
+    );
+    assert!(
+        text.contains("Under-corrected:") && text.contains("worst GGX r = 1 at 69."),
+        "{text}"
+    );
     let (code, v, _) = verify_json(
         &blender,
         &["--coefficients", "seed", "--json", "-r", "1", "-d", "ggx"],

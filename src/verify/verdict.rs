@@ -276,25 +276,38 @@ pub fn judge(
         .values()
         .any(|e| e.color_space == ColorSpace::Display)
     {
-        let worst = rows.iter().filter(|r| !r.pass).max_by(|a, b| {
-            (a.brightness - 1.0)
-                .abs()
-                .total_cmp(&(b.brightness - 1.0).abs())
-        });
+        // The worst failing sphere on each side of 100 %: the display-referred curve
+        // over-corrects some roughness values and under-corrects others.
+        let worst = |under: bool| {
+            rows.iter()
+                .filter(|r| !r.pass && (r.brightness < 1.0) == under)
+                .max_by(|a, b| {
+                    (a.brightness - 1.0)
+                        .abs()
+                        .total_cmp(&(b.brightness - 1.0).abs())
+                })
+        };
         let mut note = format!(
-            "The coefficients '{source}' are display-referred: their percentages are sRGB-encoded brightness read off a screen (sRGB(0.305) ≈ 0.59 is GGX's centre at r = 1), but a shader gain acts on linear light, so 100/f(r) under-corrects rough spheres."
+            "The coefficients '{source}' are display-referred: their percentages are sRGB-encoded brightness read off a screen (sRGB(0.305) ≈ 0.59 is GGX's centre at r = 1), but a shader gain acts on linear light, so 100/f(r) misses."
         );
-        if let Some(w) = worst {
-            note.push_str(&format!(
-                " Worst: {} r = {} comes out at {:.1} % (gain {:.3}; 1/E_avg = {:.3} is needed).",
-                w.distribution.label(),
-                w.roughness,
-                100.0 * w.brightness,
-                coefficients.distributions[&w.distribution]
-                    .curve
-                    .gain(w.roughness),
-                1.0 / w.predicted_uncorrected
-            ));
+        for (under, verb) in [(true, "Under-corrected"), (false, "Over-corrected")] {
+            if let Some(w) = worst(under) {
+                let count = rows
+                    .iter()
+                    .filter(|r| !r.pass && (r.brightness < 1.0) == under)
+                    .count();
+                note.push_str(&format!(
+                    " {verb}: {count} sphere{}, worst {} r = {} at {:.1} % (gain {:.3}; 1/E_avg = {:.3} is needed).",
+                    if count == 1 { "" } else { "s" },
+                    w.distribution.label(),
+                    w.roughness,
+                    100.0 * w.brightness,
+                    coefficients.distributions[&w.distribution]
+                        .curve
+                        .gain(w.roughness),
+                    1.0 / w.predicted_uncorrected
+                ));
+            }
         }
         notes.push(note);
     }

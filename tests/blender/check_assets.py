@@ -15,7 +15,7 @@ independently of gloffuse):
      lower studio sky (bottom corners), and different from a group of another
      distribution;
   3. where Blender stores them (3.6+), licence and copyright; always a
-     description and the tag `gloffuse`;
+     description, the author and the tag `gloffuse`;
   4. nothing else in the file: no objects, meshes, cameras, lights, materials,
      worlds or collections, no render results, one scene.
 Writes RESULT.json (what it saw, and "failures") and exits 1 on any failure.
@@ -120,6 +120,8 @@ def check(blend):
             failures.append("%s: no description" % tree.name)
         if "gloffuse" not in [t.name for t in data.tags]:
             failures.append("%s: no tag 'gloffuse'" % tree.name)
+        if data.author != "gloffuse":
+            failures.append("%s: author %r" % (tree.name, data.author))
         if bpy.app.version >= (3, 6, 0):
             entry["license"] = data.license
             entry["copyright"] = data.copyright
