@@ -5,7 +5,7 @@
 #
 # One part of the script the gloffuse binary concatenates: header
 # (GLOFFUSE_PARAMS), compat.py, params.py, nodes.py, roughness_groups.py,
-# normal_group.py, view_groups.py, groups.py, runtime.py, then a main (generate_main.py or
+# normal_group.py, view_groups.py, layered_groups.py, groups.py, runtime.py, then a main (generate_main.py or
 # furnace_main.py). It defines functions and constants only.
 # ---------------------------------------------------------------------------
 import bpy
@@ -306,3 +306,15 @@ def compat_disable_post_processing(render):
     for name in ("use_compositing", "use_sequencer"):
         if hasattr(render, name):
             setattr(render, name, False)
+
+
+def compat_principled_dielectric(node, ior):
+    """Make a Principled BSDF (otherwise at its defaults) a dielectric of index
+    `ior`. In 4.0+ its specular layer follows IOR (Specular IOR Level 0.5 keeps
+    it as is). Before 4.0 IOR drives transmission only; the specular F0 is
+    0.08 x Specular, so Specular = F0(ior) / 0.08 -- capped at 1 (F0 = 0.08,
+    IOR 1.79) by the socket."""
+    node.inputs["IOR"].default_value = ior
+    if "Specular" in node.inputs:
+        f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+        node.inputs["Specular"].default_value = min(f0 / 0.08, 1.0)

@@ -11,7 +11,7 @@
 #
 # A part of the scripts that render: the binary concatenates the header,
 # compat.py, params.py, nodes.py, roughness_groups.py, normal_group.py,
-# view_groups.py, groups.py, runtime.py, furnace.py, then furnace_main.py.
+# view_groups.py, layered_groups.py, groups.py, runtime.py, furnace.py, then furnace_main.py.
 # Functions and constants only; every Blender version difference in the scene
 # goes through compat.py's compat_* functions.
 # ---------------------------------------------------------------------------
@@ -74,24 +74,34 @@ def furnace_number(section, key, kind, low, high=None):
 
 
 def furnace_sphere_spec(index, sphere):
-    """Check one sphere entry and return a normalised copy."""
+    """Check one sphere entry and return a normalised copy. Shaders: "plain" (a
+    Glossy BSDF), "group" (a gloffuse shader group, with an "ior" for the
+    layered groups), "mix" (what artists build by hand: Mix Shader with a
+    Fresnel factor over Diffuse and Glossy) and "principled" (Principled BSDF)."""
     where = "spheres[%d]" % index
     furnace_require(isinstance(sphere, dict), "%s must be an object" % where)
     roughness = furnace_number(sphere, "roughness", float, 0.0, 1.0)
     shader = sphere.get("shader")
-    if shader == "plain":
+    spec = {"shader": shader, "roughness": roughness}
+    if shader in ("mix", "principled") or (shader == "group" and "ior" in sphere):
+        spec["ior"] = furnace_number(sphere, "ior", float, 1.0, 3.0)
+    if shader in ("plain", "mix"):
         distribution = sphere.get("distribution")
         furnace_require(distribution in FURNACE_PLAIN_DISTRIBUTIONS,
                         "%s.distribution must be one of %s, got %r"
                         % (where, ", ".join(FURNACE_PLAIN_DISTRIBUTIONS), distribution))
-        return {"shader": "plain", "distribution": distribution, "roughness": roughness}
+        spec["distribution"] = distribution
+        return spec
     if shader == "group":
         group = sphere.get("group")
         furnace_require(isinstance(group, str) and group != "",
                         "%s.group must be a node group name" % where)
-        return {"shader": "group", "group": group, "roughness": roughness}
-    raise FurnaceParamsError("furnace parameters: %s.shader must be \"plain\" or \"group\", got %r"
-                             % (where, shader))
+        spec["group"] = group
+        return spec
+    if shader == "principled":
+        return spec
+    raise FurnaceParamsError("furnace parameters: %s.shader must be \"plain\", \"group\", "
+                             "\"mix\" or \"principled\", got %r" % (where, shader))
 
 
 def furnace_color(section):
@@ -179,19 +189,54 @@ def furnace_group_output(node):
     raise RuntimeError("node group %r has no shader output" % node.node_tree.name)
 
 
+def furnace_label(sphere):
+    if sphere["shader"] == "group":
+        label = sphere["group"]
+    elif sphere["shader"] == "principled":
+        label = "Principled BSDF"
+    else:
+        label = "%s %s" % (sphere["shader"], sphere["distribution"])
+    if "ior" in sphere:
+        label += " IOR %g" % sphere["ior"]
+    return label
+
+
+def furnace_mix_shader(tree, sphere, color):
+    """Mix Shader(Fac = Fresnel(IOR), Diffuse(color), white Glossy): the
+    glossy-over-diffuse material artists build by hand."""
+    nodes, links = tree.nodes, tree.links
+    fresnel = nodes.new("ShaderNodeFresnel")
+    fresnel.inputs["IOR"].default_value = sphere["ior"]
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = tuple(color) + (1.0,)
+    glossy = glossy_node(nodes, sphere["distribution"])  # noqa: F821 -- compat.py
+    glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    glossy.inputs["Roughness"].default_value = sphere["roughness"]
+    mix = nodes.new("ShaderNodeMixShader")
+    links.new(fresnel.outputs["Fac"], mix.inputs["Fac"])
+    links.new(diffuse.outputs["BSDF"], mix.inputs[1])
+    links.new(glossy.outputs["BSDF"], mix.inputs[2])
+    return mix.outputs["Shader"]
+
+
 def furnace_material(index, sphere, color):
     """A material of colour `color`: a plain Glossy BSDF of the given
-    distribution, or the named gloffuse shader group."""
-    if sphere["shader"] == "plain":
-        label = "plain %s" % sphere["distribution"]
-    else:
-        label = sphere["group"]
-    material = bpy.data.materials.new("Furnace %03d %s r=%g" % (index, label, sphere["roughness"]))
+    distribution, a gloffuse shader group, the hand-made Mix Shader, or
+    Principled BSDF at its defaults (dielectric, IOR as given)."""
+    material = bpy.data.materials.new("Furnace %03d %s r=%g"
+                                      % (index, furnace_label(sphere), sphere["roughness"]))
     tree = compat_node_tree(material)  # noqa: F821 -- compat.py
     tree.nodes.clear()
     output = tree.nodes.new("ShaderNodeOutputMaterial")
     output.target = "ALL"
-    if sphere["shader"] == "plain":
+    if sphere["shader"] == "mix":
+        tree.links.new(furnace_mix_shader(tree, sphere, color), output.inputs["Surface"])
+        return material
+    if sphere["shader"] == "principled":
+        node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+        compat_principled_dielectric(node, sphere["ior"])  # noqa: F821 -- compat.py
+        shader_output = node.outputs["BSDF"]
+    elif sphere["shader"] == "plain":
         node = tree.nodes.new("ShaderNodeBsdfGlossy")
         node.distribution = sphere["distribution"]
         shader_output = node.outputs["BSDF"]
@@ -205,7 +250,10 @@ def furnace_material(index, sphere, color):
         node = tree.nodes.new("ShaderNodeGroup")
         node.node_tree = group
         shader_output = furnace_group_output(node)
-    node.inputs["Color"].default_value = tuple(color) + (1.0,)
+        if "ior" in sphere:
+            node.inputs["IOR"].default_value = sphere["ior"]
+    color_input = "Color" if "Color" in node.inputs else "Base Color"
+    node.inputs[color_input].default_value = tuple(color) + (1.0,)
     node.inputs["Roughness"].default_value = sphere["roughness"]
     tree.links.new(shader_output, output.inputs["Surface"])
     return material

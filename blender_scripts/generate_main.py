@@ -9,7 +9,7 @@
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
 # Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
 # params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# groups.py and runtime.py, and previews.py.
+# layered_groups.py, groups.py and runtime.py, and previews.py.
 # ---------------------------------------------------------------------------
 import sys  # also imported by runtime.py; repeated so this file reads on its own
 import tempfile

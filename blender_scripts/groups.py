@@ -3,8 +3,8 @@
 # of the parameter document is built.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
-# runtime.py, then a main. Functions only.
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
+# layered_groups.py, groups.py, runtime.py, then a main. Functions only.
 #
 #   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
 #                                                     params.py's resolve_params)
@@ -13,8 +13,8 @@
 def build_all(params):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
-    with spec["view"] the view pair and/or the multiscatter group it names, after
-    the shared normal group they use. Returns [(spec, [trees...]), ...] in
+    with spec["view"] the view pair and/or the multiscatter group it names, and
+    with spec["layered"] the layered group, after the shared normal group they use. Returns [(spec, [trees...]), ...] in
     document order; the normal group comes first with the first view spec."""
     validate_params(params)
     built = []
@@ -33,5 +33,10 @@ def build_all(params):
                 trees.append(build_view_shader_group(spec, params, view_correction))
             if view.get("multiscatter_group"):
                 trees.append(build_multiscatter_group(spec, params))
+        if spec.get("layered"):
+            if normal_tree is None:
+                normal_tree = build_normal_group(params)
+                trees.insert(0, normal_tree)
+            trees.append(build_layered_group(spec, params))
         built.append((spec, trees))
     return built

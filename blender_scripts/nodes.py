@@ -5,7 +5,7 @@
 # frames and descriptions.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; every version
 # difference it meets goes through compat.py.
 # ---------------------------------------------------------------------------

@@ -14,7 +14,7 @@
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
 # params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# groups.py, runtime.py, then a main. Functions and constants only.
+# layered_groups.py, groups.py, runtime.py, then a main. Functions and constants only.
 # ---------------------------------------------------------------------------
 import bpy
 

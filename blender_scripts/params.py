@@ -3,7 +3,7 @@
 # anything is built, and says what is wrong with it.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; uses
 # max_name_bytes() from compat.py.
 #
@@ -92,6 +92,12 @@ def resolve_params(document):
             view["image"] = family.get("image")
             view["table"] = family.get("table")
             group["view"] = view
+        if spec.get("layered_group") is not None:
+            group["layered"] = {
+                "shader_group": spec["layered_group"],
+                "image": family.get("image"), "table": family.get("table"),
+                "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
+            }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
     params["groups"] = resolved
@@ -135,6 +141,19 @@ def validate_params(params):
             if not isinstance(table, dict) or not all(
                     isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("width", "height")):
                 raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
+        layered = spec.get("layered")
+        if layered is not None:
+            views = True
+            if not isinstance(layered, dict):
+                raise ValueError("%s.layered must be an object" % where)
+            _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
+            for key in ("image", "coat_image"):
+                _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
+            coat = layered.get("coat_table")
+            if not isinstance(coat, dict) or not all(
+                    isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
+                raise ValueError("%s.layered.coat_table needs integer size and slices of at "
+                                 "least 2" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))

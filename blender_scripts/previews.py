@@ -91,7 +91,8 @@ def _render_group(scene, mesh, tree, path, made):
     node_tree.nodes.clear()
     group = node_tree.nodes.new("ShaderNodeGroup")
     group.node_tree = tree
-    group.inputs["Color"].default_value = PREVIEW_COLOR
+    color_input = "Color" if "Color" in group.inputs else "Base Color"  # layered groups
+    group.inputs[color_input].default_value = PREVIEW_COLOR
     group.inputs["Roughness"].default_value = PREVIEW_ROUGHNESS
     output = node_tree.nodes.new("ShaderNodeOutputMaterial")
     node_tree.links.new(group.outputs["BSDF"], output.inputs["Surface"])
@@ -119,9 +120,11 @@ def render_previews(built, params, directory):
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
             view = spec.get("view") or {}
+            layered = spec.get("layered") or {}
             pairs = [(spec["shader_group"], [spec["correction_group"]]),
                      (view.get("shader_group"), [view.get("correction_group")]),
-                     (view.get("multiscatter_group"), [])]
+                     (view.get("multiscatter_group"), []),
+                     (layered.get("shader_group"), [])]
             for shader_name, helpers in pairs:
                 tree = by_name.get(shader_name)
                 if tree is None:
@@ -134,8 +137,9 @@ def render_previews(built, params, directory):
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
             normal = by_name.get(params.get("normal_group"))
-            if normal is not None and view.get("shader_group") in shown:
-                _set_preview(normal, shown[view["shader_group"]])
+            first_view = view.get("shader_group") or layered.get("shader_group")
+            if normal is not None and first_view in shown:
+                _set_preview(normal, shown[first_view])
     finally:
         # One batch: removing a mesh one by one would take its object with it first.
         bpy.data.batch_remove(made)

@@ -4,7 +4,7 @@
 # curve) and the shader group (a Glossy BSDF whose colour goes through it).
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only.
 #
 #   build_correction_group(spec, params) -> correction tree

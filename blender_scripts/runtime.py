@@ -5,7 +5,7 @@
 # Blender.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and classes only.
 #
 #   script_args(argv=None) -> the arguments meant for the script

@@ -16,7 +16,7 @@
 # Fms = C E_avg / (1 - C (1 - E_avg)), colour C (1 + Fms (1 - E) / E).
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; the socket lists
 # below extend roughness_groups.py's.
 # ---------------------------------------------------------------------------
@@ -53,7 +53,16 @@ def albedo_image(view):
     average = finite_list(table["average"], "view.table.average")
     if len(average) != width:
         raise ValueError("view.table.average holds %d values, not %d" % (len(average), width))
-    name = view["image"]
+    pixels = []
+    for index, value in enumerate(values):
+        pixels.extend((value, average[index % width], value, value))
+    return packed_float_image(view["image"], width, height, pixels)
+
+
+def packed_float_image(name, width, height, pixels):
+    """A non-colour, channel-packed 32-bit float image packed into the .blend:
+    reused by name (resized if needed) and filled with `pixels` (RGBA, bottom
+    row first)."""
     image = bpy.data.images.get(name)
     if image is not None and tuple(image.size) != (width, height):
         image.scale(width, height)
@@ -61,9 +70,6 @@ def albedo_image(view):
         image = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
     image.colorspace_settings.name = "Non-Color"
     image.alpha_mode = "CHANNEL_PACKED"
-    pixels = []
-    for index, value in enumerate(values):
-        pixels.extend((value, average[index % width], value, value))
     image.pixels.foreach_set(pixels)
     image.update()
     image.file_format = "OPEN_EXR"

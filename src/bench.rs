@@ -48,7 +48,7 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
         ColorModel::Exact,
     )?;
     let rs: Vec<f64> = b.roughness.iter().map(|r| r.get()).collect();
-    let plan = Plan::verify(&Distribution::ALL, &rs, b.render);
+    let plan = Plan::verify(&Distribution::ALL, &rs, &[], b.render);
     let timeout = b.blender.timeout;
     let start = Instant::now();
     render(

@@ -254,3 +254,50 @@ fn tables_are_identical_for_any_thread_count() {
         assert_eq!(bits(&one), bits(&other), "{threads} threads");
     }
 }
+
+/// The Fresnel-weighted albedo `E_F(μ, r, η)` the coat is made of, against the brute force
+/// with the same Fresnel at every direction; and the coat's closed-form limits: at normal
+/// incidence of a smooth coat `F0`, and for a grazing view of any coat less than 1.
+#[test]
+fn fresnel_weighted_albedo_matches_brute_force() {
+    use gloffuse::measure::fresnel;
+    let q = AlbedoIntegrator::default();
+    let mut cases = Vec::new();
+    for d in Distribution::ALL {
+        for m in MASKINGS {
+            for r in [0.1, 0.4, 0.8, 1.0] {
+                for mu in [0.05, 0.3, 0.7, 1.0] {
+                    for eta in [1.05, 1.5, 2.5] {
+                        cases.push((glossy(d, m, r), mu, eta));
+                    }
+                }
+            }
+        }
+    }
+    let failures: Vec<String> = cases
+        .par_iter()
+        .filter_map(|&(g, mu, eta)| {
+            let reference = common::oracle::brute_force_weighted(&g, mu, 1500, 1500, &|c| {
+                fresnel::dielectric(c, eta)
+            });
+            let (e_f, e) = q.fresnel_albedo(&g, mu, eta);
+            let a = q.coat(&g, mu, eta);
+            let bad = (e_f - reference).abs() > 1e-4 || e_f > e || !(e_f..=1.0).contains(&a);
+            bad.then(|| {
+                format!(
+                    "{} {} alpha {} mu {mu} eta {eta}: E_F {e_f} vs {reference} (E {e}, A {a})",
+                    g.distribution(),
+                    g.masking,
+                    g.microfacet.alpha
+                )
+            })
+        })
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} off:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
+}

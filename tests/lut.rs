@@ -23,10 +23,10 @@ fn small(kind: Kind, out: &Path, format: Format, bits: Bits) -> LutOptions {
     let mut args = LutOptions::new(kind, out);
     args.size = Some(match kind {
         Kind::SplitSum => 24,
-        Kind::KullaConty | Kind::Albedo => 8,
+        Kind::KullaConty | Kind::Albedo | Kind::Coat => 8,
     });
-    // The albedo table is quadrature: it takes no samples.
-    args.samples = (kind != Kind::Albedo).then_some(256);
+    // The albedo and coat tables are quadrature: they take no samples.
+    args.samples = matches!(kind, Kind::SplitSum | Kind::KullaConty).then_some(256);
     args.format = Some(format);
     args.bits = bits;
     args
@@ -65,7 +65,7 @@ fn assert_same_texels(found: &[f32], table: &Table, bits: Bits, what: &str) {
     }
 }
 
-const KINDS: [Kind; 3] = [Kind::SplitSum, Kind::KullaConty, Kind::Albedo];
+const KINDS: [Kind; 4] = [Kind::SplitSum, Kind::KullaConty, Kind::Albedo, Kind::Coat];
 const BITS: [Bits; 2] = [Bits::Half, Bits::Float];
 
 #[test]
@@ -148,8 +148,12 @@ fn dds_reads_back_with_ddsfile() {
             let summary = lut(&args, &Quiet).unwrap();
             let dds = Dds::read(std::fs::File::open(&path).unwrap()).unwrap();
             let expected = match (kind, bits) {
-                (Kind::SplitSum | Kind::Albedo, Bits::Half) => DxgiFormat::R16G16_Float,
-                (Kind::SplitSum | Kind::Albedo, Bits::Float) => DxgiFormat::R32G32_Float,
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Half) => {
+                    DxgiFormat::R16G16_Float
+                }
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Float) => {
+                    DxgiFormat::R32G32_Float
+                }
                 (Kind::KullaConty, Bits::Half) => DxgiFormat::R16G16B16A16_Float,
                 (Kind::KullaConty, Bits::Float) => DxgiFormat::R32G32B32A32_Float,
             };
@@ -189,8 +193,12 @@ fn ktx2_reads_back_with_the_ktx2_crate() {
             let reader = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             let header = reader.header();
             let format = match (kind, bits) {
-                (Kind::SplitSum | Kind::Albedo, Bits::Half) => ktx2::Format::R16G16_SFLOAT,
-                (Kind::SplitSum | Kind::Albedo, Bits::Float) => ktx2::Format::R32G32_SFLOAT,
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Half) => {
+                    ktx2::Format::R16G16_SFLOAT
+                }
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Float) => {
+                    ktx2::Format::R32G32_SFLOAT
+                }
                 (Kind::KullaConty, Bits::Half) => ktx2::Format::R16G16B16A16_SFLOAT,
                 (Kind::KullaConty, Bits::Float) => ktx2::Format::R32G32B32A32_SFLOAT,
             };

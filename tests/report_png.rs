@@ -110,6 +110,8 @@ fn white_row(
     Row {
         distribution,
         roughness,
+        ior: None,
+        cells: [0, 0],
         target: [1.0; 3],
         uncorrected_brightness: uncorrected.mean,
         brightness: corrected.mean,
@@ -127,6 +129,8 @@ fn white_row(
 fn reference_sphere(roughness: f64, stats: SphereStats) -> ReferenceSphere {
     ReferenceSphere {
         roughness,
+        ior: None,
+        cell: 0,
         brightness: stats.mean,
         stats,
     }
@@ -371,8 +375,8 @@ fn full_sweep_sheet_and_plot() {
     let roughness: Vec<f64> = (0..=10).map(|i| i as f64 / 10.0).collect();
     let settings = RenderSettings::default();
     let cell = settings.cell as usize;
-    let plan = Plan::verify(&Distribution::ALL, &roughness, settings);
-    let (row_labels, column_labels) = sheet_labels(&plan);
+    let plan = Plan::verify(&Distribution::ALL, &roughness, &[], settings);
+    let (row_labels, column_labels) = sheet_labels(&plan, gloffuse::generate::Mode::Roughness);
     assert_eq!(row_labels.len(), 7);
     assert_eq!(row_labels[4], "Ashikhmin-Shirley uncorrected");
     assert_eq!(row_labels[6], "Multiscatter GGX");

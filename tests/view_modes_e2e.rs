@@ -80,7 +80,7 @@ fn the_roughness_only_gain_leaves_rings_uneven() {
 }
 
 #[test]
-fn generate_builds_the_view_and_multiscatter_groups() {
+fn generate_builds_the_view_multiscatter_and_layered_groups_together() {
     let Some(blender) = common::blender::real_blender("4.5") else {
         return;
     };
@@ -90,7 +90,7 @@ fn generate_builds_the_view_and_multiscatter_groups() {
             "generate",
             "--json",
             "--mode",
-            "view,multiscatter",
+            "view,multiscatter,layered",
             "--no-provision",
             "--blend",
         ])
@@ -116,6 +116,10 @@ fn generate_builds_the_view_and_multiscatter_groups() {
         "Gloffuse View (GGX)",
         "Gloffuse Multiscatter (GGX)",
         "Gloffuse Multiscatter (Ashikhmin-Shirley)",
+        "Gloffuse Layered (Beckmann)",
+        "Gloffuse Layered (GGX)",
+        "Gloffuse Layered (Ashikhmin-Shirley)",
+        "Gloffuse Shading Normal",
     ] {
         assert!(groups.contains(&name), "{name} missing from {groups:?}");
     }

@@ -15,7 +15,7 @@ use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Sampling};
 use gloffuse::measure::brdf::{Model, ModelParams};
 use gloffuse::measure::{BlenderVersion, Distribution, Roughness};
 use gloffuse::refresh::RefreshOptions;
-use gloffuse::verify::{Judging, RenderSettings, VerifyOptions};
+use gloffuse::verify::{Judging, LAYERED_IOR, RenderSettings, VerifyOptions, layered_roughness};
 
 const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
 const LONG_ABOUT: &str = "\
@@ -156,6 +156,10 @@ const MODES: &[Choice<Mode>] = &[
         Mode::Multiscatter,
         "Glossy plus a diffuse lobe of colour × (1 − E(μ, r)): every pixel 100 %, highlight unchanged",
     ),
+    choice(
+        Mode::Layered,
+        "a dielectric glossy coat (IOR) over a diffuse base: a white base reflects 100 % at every pixel",
+    ),
 ];
 
 const COLOR_MODELS: &[Choice<ColorModel>] = &[
@@ -200,6 +204,10 @@ const KINDS: &[Choice<Kind>] = &[
     choice(
         Kind::Albedo,
         "Kulla–Conty's albedo tables for a Cycles Glossy BSDF (R = E(μ, r), G = E_avg(r))",
+    ),
+    choice(
+        Kind::Coat,
+        "the layered shader's dielectric coat: 12 IOR slices side by side (R = A(μ, r, IOR), G = E(μ, r))",
     ),
 ];
 
@@ -258,6 +266,15 @@ fn parse_distribution(s: &str) -> Result<Distribution, String> {
 
 fn parse_model(s: &str) -> Result<Model, String> {
     s.parse().map_err(|e: gloffuse::Error| e.to_string())
+}
+
+fn parse_ior(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(n) if (1.0..=3.0).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "'{s}' is not an index of refraction from 1 to 3 (e.g. 1.5, glass)"
+        )),
+    }
 }
 
 fn parse_roughness(s: &str) -> Result<Roughness, String> {
@@ -539,10 +556,15 @@ pub struct VerifyArgs {
     #[arg(long, short = 'd', value_delimiter = ',', value_parser = parse_distribution)]
     pub distribution: Vec<Distribution>,
 
-    /// Roughness values of the sweep, comma-separated, each from 0 to 1 and given once.
-    #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness, allow_hyphen_values = true,
-          default_values_t = verify_defaults().roughness)]
+    /// Roughness values of the sweep, comma-separated, each from 0 to 1 and given once
+    /// [default: 0, 0.1, …, 1; layered mode: 0.1, 0.25, 0.5, 0.75, 1].
+    #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness, allow_hyphen_values = true)]
     pub roughness: Vec<Roughness>,
+
+    /// Layered mode: the coats' indices of refraction, comma-separated, each from 1 to 3
+    /// and given once [default: 1.33,1.5,2].
+    #[arg(long, value_name = "N,...", value_delimiter = ',', value_parser = parse_ior)]
+    pub ior: Vec<f64>,
 
     /// Cycles samples per pixel (32 keeps each sphere's standard error ≤ 0.2 %).
     #[arg(long, default_value_t = verify_defaults().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
@@ -561,8 +583,9 @@ pub struct VerifyArgs {
     pub seed: u32,
 
     /// Which correction to check: roughness (gain 100/f(r), judged by each sphere's mean),
-    /// view (gain 1/E(μ, r)) or multiscatter (Glossy + diffuse (1 − E)), the last two also
-    /// judged ring by ring.
+    /// view (gain 1/E(μ, r)), multiscatter (Glossy + diffuse (1 − E)) or layered (the
+    /// glossy-over-diffuse groups at each --ior, next to the hand-made Mix Shader and
+    /// Principled BSDF), all but the first also judged ring by ring.
     #[arg(long, value_parser = one_of(MODES, Mode::key), default_value = verify_defaults().mode.key())]
     pub mode: Mode,
 
@@ -603,7 +626,15 @@ impl VerifyArgs {
         VerifyOptions {
             coefficients: self.coefficients.clone(),
             distributions: self.distribution.clone(),
-            roughness: self.roughness.clone(),
+            roughness: match (self.roughness.is_empty(), self.mode) {
+                (false, _) => self.roughness.clone(),
+                (true, Mode::Layered) => layered_roughness(),
+                (true, _) => verify_defaults().roughness,
+            },
+            ior: match (self.ior.is_empty(), self.mode) {
+                (true, Mode::Layered) => LAYERED_IOR.to_vec(),
+                _ => self.ior.clone(),
+            },
             render: RenderSettings {
                 cell: self.resolution,
                 samples: self.spp,
@@ -702,19 +733,19 @@ impl BenchArgs {
 /// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
 #[derive(Args, Debug, Clone, PartialEq)]
 pub struct LutArgs {
-    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G).
+    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G); coat: A(μ, r, IOR), E(μ, r) (R, G) in 12 slices of IOR 1 to 3 side by side.
     #[arg(long, value_parser = one_of(KINDS, Kind::key), default_value = Kind::SplitSum.key())]
     pub kind: Kind,
 
-    /// kulla-conty and albedo: beckmann, ggx or ashikhmin-shirley [default: ggx].
+    /// kulla-conty, albedo and coat: beckmann, ggx or ashikhmin-shirley [default: ggx].
     #[arg(long, short = 'd', value_parser = parse_distribution)]
     pub distribution: Option<Distribution>,
 
-    /// kulla-conty and albedo: the Blender whose masking the BSDF follows (3.0–3.4 separable, 3.5+ height-correlated) [default: 4.5].
+    /// kulla-conty, albedo and coat: the Blender whose masking the BSDF follows (3.0–3.4 separable, 3.5+ height-correlated) [default: 4.5].
     #[arg(long, value_parser = parse_version)]
     pub blender_version: Option<BlenderVersion>,
 
-    /// Texels per side, 1 to 8192 [default: 512 for split-sum, 64 for kulla-conty and albedo].
+    /// Texels per side (per slice for coat), 1 to 8192 [default: 512 for split-sum, 64 otherwise].
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
 

@@ -103,10 +103,26 @@ pub fn lut(s: &LutSummary) -> String {
     for c in &s.channels {
         out += &format!("  {c}\n");
     }
-    out += &format!(
-        "  uv = (roughness, N·V); texel (x, y) at ((x + ½)/{}, (y + ½)/{}), first row first\n",
-        s.width, s.height
-    );
+    match &s.ior {
+        Some(ior) => {
+            let n = s.height;
+            let list: Vec<String> = ior.iter().map(|v| format!("{v:.3}")).collect();
+            out += &format!(
+                "  {} slices of {n}×{n} side by side, slice k at IOR {}\n",
+                ior.len(),
+                list.join(", ")
+            );
+            out += &format!(
+                "  in slice k, texel (x, y) at roughness (x − {n}k + ½)/{n}, N·V (y + ½)/{n}, first row first\n"
+            );
+        }
+        None => {
+            out += &format!(
+                "  uv = (roughness, N·V); texel (x, y) at ((x + ½)/{}, (y + ½)/{}), first row first\n",
+                s.width, s.height
+            );
+        }
+    }
     out += &format!(
         "  computed in {:.2} s ({:.2} s in all)\n",
         s.compute_seconds, s.seconds

@@ -7,7 +7,7 @@ use serde::Serialize;
 use super::catalogs::Catalogs;
 use crate::Error;
 use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
-use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Masking, Roughness};
+use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Masking, Roughness, coat};
 use crate::progress::Quiet;
 
 /// Which correction a shader group applies.
@@ -20,17 +20,32 @@ pub enum Mode {
     View,
     /// Glossy plus a diffuse lobe of colour × (1 − E(μ, r)): every pixel 100 %, highlight unchanged.
     Multiscatter,
+    /// A dielectric glossy coat over a diffuse base (`Gloffuse Layered (…)`): the coat
+    /// reflects A(μ, r, IOR), the base gets the rest.
+    Layered,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 3] = [Mode::Roughness, Mode::View, Mode::Multiscatter];
+    pub const ALL: [Mode; 4] = [
+        Mode::Roughness,
+        Mode::View,
+        Mode::Multiscatter,
+        Mode::Layered,
+    ];
 
     pub fn key(self) -> &'static str {
         match self {
             Mode::Roughness => "roughness",
             Mode::View => "view",
             Mode::Multiscatter => "multiscatter",
+            Mode::Layered => "layered",
         }
+    }
+
+    /// Does this mode's shader group read the view cosine (so that every pixel, not only
+    /// the sphere's mean, is judged)?
+    pub fn per_pixel(self) -> bool {
+        self != Mode::Roughness
     }
 }
 
@@ -61,6 +76,47 @@ impl ColorModel {
 /// bilinear interpolation of 96 × 96 samples stays within 0.33 % of E for μ ≥ 0.05
 /// (`cargo run --release --example view_table_error`).
 pub const VIEW_TABLE_SIZE: usize = 96;
+
+/// Side of each index slice of the coat table packed for the layered groups: with
+/// [`coat::SLICES`] slices, bilinear in (r, μ) and linear between slices, A stays within
+/// 5.7e-3 of the integrator (`cargo run --release --example coat_table_error`).
+pub const COAT_TABLE_SIZE: usize = 64;
+
+/// The coat albedo `A(μ, r, η)` of the layered groups as one image: [`coat::SLICES`] slices
+/// side by side, slice k for index `ior[k]` (even in `z = F0^¼`), each `size` × `size` with
+/// row i at μ = i/(size − 1) and column j at r = j/(size − 1).
+#[derive(Clone, Debug, Serialize)]
+pub struct CoatTable {
+    pub size: usize,
+    pub slices: usize,
+    pub ior: Vec<f64>,
+    /// `z = F0^¼` of the last slice (the first is 0).
+    pub z_max: f64,
+    /// Image rows, bottom first: `values[i * size * slices + k * size + j]`.
+    pub values: Vec<f32>,
+}
+
+impl CoatTable {
+    pub fn compute(distribution: Distribution, masking: Masking, size: usize) -> Self {
+        let integrator = AlbedoIntegrator::default();
+        let axis = Roughness::grid(size);
+        let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
+        let grid = integrator.coat_grid(distribution, masking, &axis, &mus, &Quiet);
+        let mut values = Vec::with_capacity(size * size * coat::SLICES);
+        for i in 0..size {
+            for k in 0..coat::SLICES {
+                values.extend((0..size).map(|j| grid.a(k, i, j) as f32));
+            }
+        }
+        CoatTable {
+            size,
+            slices: coat::SLICES,
+            ior: grid.ior.to_vec(),
+            z_max: coat::slice_coordinate(coat::IOR_MAX),
+            values,
+        }
+    }
+}
 
 /// E(μ, r) on a grid (row i is μ = i/(height − 1), column j is r = j/(width − 1)) and
 /// E_avg(r) per column.
@@ -118,6 +174,11 @@ pub struct FamilySpec {
     pub image: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub table: Option<AlbedoTable>,
+    /// Name of the packed float image holding `coat_table` (layered mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coat_image: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coat_table: Option<CoatTable>,
 }
 
 /// One distribution's node groups, as the Python side builds them. The script picks the
@@ -132,6 +193,9 @@ pub struct GroupSpec {
     /// The view and multiscatter groups (only when a mode asks for them).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub view: Option<ViewNames>,
+    /// `Gloffuse Layered (…)` (layered mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layered_group: Option<String>,
     pub families: Vec<FamilySpec>,
 }
 
@@ -143,6 +207,7 @@ impl GroupSpec {
             Mode::Roughness => Some(&self.shader_group),
             Mode::View => view.and_then(|v| v.shader_group.as_deref()),
             Mode::Multiscatter => view.and_then(|v| v.multiscatter_group.as_deref()),
+            Mode::Layered => self.layered_group.as_deref(),
         }
     }
 
@@ -153,6 +218,7 @@ impl GroupSpec {
             let view = [&v.correction_group, &v.shader_group, &v.multiscatter_group];
             names.extend(view.into_iter().flatten().cloned());
         }
+        names.extend(self.layered_group.iter().cloned());
         names
     }
 }
@@ -208,6 +274,11 @@ pub fn correction_group_name(d: Distribution) -> String {
     format!("Brightness Correction ({})", d.label())
 }
 
+/// `Gloffuse Layered (GGX)`: the public name of the glossy-over-diffuse group.
+pub fn layered_group_name(d: Distribution) -> String {
+    format!("Gloffuse Layered ({})", d.label())
+}
+
 /// `Gloffuse (GGX)`: the public name of the corrected shader group.
 pub fn shader_group_name(d: Distribution) -> String {
     format!("Gloffuse ({})", d.label())
@@ -234,7 +305,9 @@ impl GenerateParams {
             loaded.push((masking, coefficients, name));
         }
         let wants = |m: Mode| modes.contains(&m);
-        let views = wants(Mode::View) || wants(Mode::Multiscatter);
+        // Every per-pixel group reads E(μ, r) and the shading normal.
+        let views = modes.iter().any(|m| m.per_pixel());
+        let layered = wants(Mode::Layered);
         let distributions: Vec<Distribution> = loaded
             .first()
             .map(|(_, c, _)| c.distributions.keys().copied().collect())
@@ -245,7 +318,8 @@ impl GenerateParams {
                 distribution: d,
                 correction_group: correction_group_name(d),
                 shader_group: shader_group_name(d),
-                view: views.then(|| ViewNames {
+                layered_group: layered.then(|| layered_group_name(d)),
+                view: (wants(Mode::View) || wants(Mode::Multiscatter)).then(|| ViewNames {
                     correction_group: wants(Mode::View)
                         .then(|| format!("Brightness Correction View ({})", d.label())),
                     shader_group: wants(Mode::View)
@@ -266,6 +340,10 @@ impl GenerateParams {
                                 .then(|| format!("Gloffuse E(mu, r) ({}, {})", d.label(), masking)),
                             table: views
                                 .then(|| AlbedoTable::compute(d, *masking, VIEW_TABLE_SIZE)),
+                            coat_image: layered
+                                .then(|| format!("Gloffuse coat A ({}, {})", d.label(), masking)),
+                            coat_table: layered
+                                .then(|| CoatTable::compute(d, *masking, COAT_TABLE_SIZE)),
                         })
                     })
                     .collect(),

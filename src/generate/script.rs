@@ -9,7 +9,7 @@ use serde::Serialize;
 
 /// The library parts, in the order they are concatenated: each defines functions only,
 /// and may use what the parts before it define (see `docs/ARCHITECTURE.md`).
-pub const PARTS: [(&str, &str); 8] = [
+pub const PARTS: [(&str, &str); 9] = [
     ("compat.py", include_str!("../../blender_scripts/compat.py")),
     ("params.py", include_str!("../../blender_scripts/params.py")),
     ("nodes.py", include_str!("../../blender_scripts/nodes.py")),
@@ -24,6 +24,10 @@ pub const PARTS: [(&str, &str); 8] = [
     (
         "view_groups.py",
         include_str!("../../blender_scripts/view_groups.py"),
+    ),
+    (
+        "layered_groups.py",
+        include_str!("../../blender_scripts/layered_groups.py"),
     ),
     ("groups.py", include_str!("../../blender_scripts/groups.py")),
     (

@@ -29,6 +29,10 @@
 //!   `F_avg E_avg / (1 − F_avg (1 − E_avg))` that scales B under a coloured Fresnel.
 //!   `E(μ, r)` itself (Cycles-exact, from [`crate::measure::AlbedoIntegrator`]) is in
 //!   [`kulla_conty::KullaConty::e`].
+//! * [`Kind::Coat`], 2 channels, the coat of the layered shader (see [`coat`]): 12 slices of
+//!   n × n side by side (an atlas 12n wide), slice k for index of refraction `ior[k]`
+//!   (listed in the summary): **R = A(μ, r, η)**, the albedo of a dielectric microfacet
+//!   coat with its lost energy given back, **G = E(μ, r)**. Quadrature, no samples.
 //!
 //! # Formats
 //!
@@ -39,6 +43,7 @@
 //! * KTX 2.0 (written here, see [`ktx2`]): VK_FORMAT_R16G16_SFLOAT / R32G32_SFLOAT or
 //!   R16G16B16A16_SFLOAT / R32G32B32A32_SFLOAT, one level, no supercompression.
 
+pub mod coat;
 pub mod dds;
 pub mod ktx2;
 pub mod kulla_conty;
@@ -68,6 +73,9 @@ pub enum Kind {
     KullaConty,
     /// Kulla–Conty's albedo tables for a Cycles Glossy BSDF (R = E(μ, r), G = E_avg(r)).
     Albedo,
+    /// The layered shader's coat: slices over the index of refraction (R = A(μ, r, η),
+    /// G = E(μ, r)).
+    Coat,
 }
 
 impl Kind {
@@ -76,6 +84,7 @@ impl Kind {
             Kind::SplitSum => "split-sum",
             Kind::KullaConty => "kulla-conty",
             Kind::Albedo => "albedo",
+            Kind::Coat => "coat",
         }
     }
 }
@@ -274,6 +283,11 @@ pub enum Spec {
         distribution: Distribution,
         blender_version: BlenderVersion,
     },
+    Coat {
+        size: usize,
+        distribution: Distribution,
+        blender_version: BlenderVersion,
+    },
 }
 
 impl Spec {
@@ -282,7 +296,7 @@ impl Spec {
         let (default_size, default_samples) = match args.kind {
             Kind::SplitSum => (512, 2048),
             Kind::KullaConty => (64, 4096),
-            Kind::Albedo => (64, 1),
+            Kind::Albedo | Kind::Coat => (64, 1),
         };
         let size = args.size.unwrap_or(default_size);
         let samples = args.samples.unwrap_or(default_samples);
@@ -298,6 +312,17 @@ impl Spec {
                 "--samples",
                 &samples.to_string(),
                 &format!("samples per texel from 1 to {MAX_SAMPLES}"),
+            ));
+        }
+        if args.kind == Kind::Coat && size > coat::MAX_SIZE {
+            return Err(Error::input(
+                "--size",
+                &size.to_string(),
+                &format!(
+                    "texels per slice side from 1 to {} for --kind coat (its atlas is {} slices wide)",
+                    coat::MAX_SIZE,
+                    crate::measure::coat::SLICES
+                ),
             ));
         }
         let size = size as usize;
@@ -324,7 +349,7 @@ impl Spec {
                     sampling: args.sampling.unwrap_or(Sampling::VisibleNormals),
                 })
             }
-            Kind::KullaConty | Kind::Albedo => {
+            Kind::KullaConty | Kind::Albedo | Kind::Coat => {
                 let kind = args.kind.key();
                 if let Some(g) = args.g_model {
                     return Err(Error::input(
@@ -356,8 +381,17 @@ impl Spec {
                     return Err(Error::input(
                         "--samples",
                         &n.to_string(),
-                        "nothing with --kind albedo (E is integrated by deterministic quadrature, not sampled)",
+                        &format!(
+                            "nothing with --kind {kind} (it is integrated by deterministic quadrature, not sampled)"
+                        ),
                     ));
+                }
+                if args.kind == Kind::Coat {
+                    return Ok(Spec::Coat {
+                        size,
+                        distribution,
+                        blender_version,
+                    });
                 }
                 Ok(Spec::Albedo {
                     size,
@@ -371,7 +405,9 @@ impl Spec {
     /// How many times [`Spec::compute`] steps its `progress`.
     pub fn progress_steps(&self) -> usize {
         match *self {
-            Spec::SplitSum { size, .. } | Spec::Albedo { size, .. } => size,
+            Spec::SplitSum { size, .. } | Spec::Albedo { size, .. } | Spec::Coat { size, .. } => {
+                size
+            }
             Spec::KullaConty { size, .. } => 2 * size,
         }
     }
@@ -408,6 +444,11 @@ impl Spec {
                 distribution,
                 blender_version,
             } => kulla_conty::albedo_table(size, distribution, blender_version.masking(), progress),
+            Spec::Coat {
+                size,
+                distribution,
+                blender_version,
+            } => coat::coat_table(size, distribution, blender_version.masking(), progress),
         }
     }
 }
@@ -446,6 +487,9 @@ pub struct LutSummary {
     pub distribution: Option<Distribution>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blender_version: Option<String>,
+    /// coat: the index of refraction of each slice, in order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ior: Option<Vec<f64>>,
     /// Size of the written file.
     pub bytes: usize,
     /// Wall-clock seconds spent computing the table (excluding encoding and writing).
@@ -520,13 +564,23 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
             distribution,
             blender_version,
             ..
+        }
+        | Spec::Coat {
+            distribution,
+            blender_version,
+            ..
         } => (
             None,
             None,
             None,
             Some(distribution),
             Some(blender_version.to_string()),
-            vec!["R: E(μ, r)".to_string(), "G: E_avg(r)".to_string()],
+            match spec {
+                Spec::Coat { .. } => ["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
+                _ => ["R: E(μ, r)", "G: E_avg(r)"],
+            }
+            .map(String::from)
+            .to_vec(),
         ),
     };
     Ok(LutSummary {
@@ -543,6 +597,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         sampling,
         distribution,
         blender_version,
+        ior: matches!(spec, Spec::Coat { .. }).then(coat::ior),
         bytes: bytes.len(),
         compute_seconds,
         seconds: start.elapsed().as_secs_f64(),

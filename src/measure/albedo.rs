@@ -93,15 +93,17 @@ impl AlbedoIntegrator {
         }
     }
 
-    /// ∫₀^π weight dφ for one polar angle, in pieces cut at every event's azimuth.
-    fn azimuth_integral(
+    /// ∫₀^π weight dφ for one polar angle, in pieces cut at every event's azimuth, for each
+    /// of the `N` factors `factors(ωo·h)` the sample weight is multiplied by.
+    fn azimuth_integral<const N: usize>(
         &self,
         glossy: &Glossy,
         mu: f64,
         sin_o: f64,
         h: Polar,
         events: &[f64],
-    ) -> f64 {
+        factors: &impl Fn(f64) -> [f64; N],
+    ) -> [f64; N] {
         // ωo·h = A cos φ + B with A = sinθo sinθh, B = μ cosθh.
         let (a, b) = (sin_o * h.sin, mu * h.cos);
         let mut cuts = vec![0.0, PI];
@@ -114,21 +116,24 @@ impl AlbedoIntegrator {
             }
         }
         cuts.sort_by(f64::total_cmp);
-        let mut total = 0.0;
+        let mut total = [0.0; N];
         for pair in cuts.windows(2) {
             let (lo, hi) = (pair[0], pair[1]);
             if hi <= lo {
                 continue;
             }
-            let sum: f64 = self
-                .phi_rule
-                .iter()
-                .map(|&(x, w)| {
-                    let cos_phi = (lo + (hi - lo) * x).cos();
-                    w * glossy.half_vector_sample(mu, sin_o, h, cos_phi).weight
-                })
-                .sum();
-            total += sum * (hi - lo);
+            let mut sum = [0.0; N];
+            for &(x, w) in &self.phi_rule {
+                let cos_phi = (lo + (hi - lo) * x).cos();
+                let sample = glossy.half_vector_sample(mu, sin_o, h, cos_phi);
+                let f = factors(sample.o_dot_h);
+                for k in 0..N {
+                    sum[k] += w * (f[k] * sample.weight);
+                }
+            }
+            for k in 0..N {
+                total[k] += sum[k] * (hi - lo);
+            }
         }
         total
     }
@@ -136,9 +141,22 @@ impl AlbedoIntegrator {
     /// Directional albedo `E(μ) = ∫ f(ωo, ωi) cosθi dωi` for view cosine `mu` ∈ (0, 1], as
     /// Cycles renders it. Roughness 0 is Cycles' perfect mirror: exactly 1.
     pub fn directional_albedo(&self, glossy: &Glossy, mu: f64) -> f64 {
+        self.directional_moments(glossy, mu, &|_| [1.0])[0]
+    }
+
+    /// `∫ f(ωo, ωi) cosθi · factor_k(ωo·h) dωi` for each of the `N` factors at once (one pass
+    /// over the half vectors): with a factor of 1 the albedo, with a Fresnel term the albedo
+    /// of a Fresnel-weighted lobe, with Schlick's weights the split-sum scale and bias. At
+    /// roughness 0 (the mirror, h = n) it is `factor(μ)`.
+    pub fn directional_moments<const N: usize>(
+        &self,
+        glossy: &Glossy,
+        mu: f64,
+        factors: &impl Fn(f64) -> [f64; N],
+    ) -> [f64; N] {
         let lobe = glossy.microfacet;
         if lobe.alpha <= 0.0 {
-            return 1.0;
+            return factors(mu.clamp(0.0, 1.0));
         }
         let mu = mu.clamp(1e-9, 1.0);
         let sin_o = (1.0 - mu * mu).max(0.0).sqrt();
@@ -168,10 +186,10 @@ impl AlbedoIntegrator {
         cuts.sort_by(f64::total_cmp);
         cuts.dedup_by(|x, y| (*x - *y).abs() < 1e-12);
 
-        let mut total = 0.0;
+        let mut total = [0.0; N];
         for pair in cuts.windows(2) {
             let (t0, t1) = (pair[0], pair[1]);
-            let azimuth = |h: Polar| self.azimuth_integral(glossy, mu, sin_o, h, &events);
+            let azimuth = |h: Polar| self.azimuth_integral(glossy, mu, sin_o, h, &events, factors);
             // GGX's heavy tail (D → α²/π at grazing) spans decades of tanθh away from the
             // peak; Beckmann's and Ashikhmin–Shirley's tails vanish too fast for that.
             let heavy_tail = lobe.distribution == Distribution::Ggx;
@@ -181,28 +199,34 @@ impl AlbedoIntegrator {
                 if s_hi <= s_lo {
                     continue;
                 }
-                let piece: f64 = self
-                    .theta_rule
-                    .iter()
-                    .map(|&(x, w)| w * azimuth(lobe.polar_from_survival(s_lo + (s_hi - s_lo) * x)))
-                    .sum();
-                total += piece * (s_hi - s_lo);
+                let mut piece = [0.0; N];
+                for &(x, w) in &self.theta_rule {
+                    let az = azimuth(lobe.polar_from_survival(s_lo + (s_hi - s_lo) * x));
+                    for k in 0..N {
+                        piece[k] += w * az[k];
+                    }
+                }
+                for k in 0..N {
+                    total[k] += piece[k] * (s_hi - s_lo);
+                }
             } else {
                 // In the heavy tail, integrate in ln tanθh, where the integrand is smooth.
                 let (w0, w1) = (t0.tan().ln(), t1.tan().ln());
-                let piece: f64 = self
-                    .theta_rule
-                    .iter()
-                    .map(|&(x, w)| {
-                        let h = Polar::from_tan2((2.0 * (w0 + (w1 - w0) * x)).exp());
-                        w * azimuth(h) * lobe.density(h) * h.sin * h.cos
-                    })
-                    .sum();
-                total += piece * (w1 - w0);
+                let mut piece = [0.0; N];
+                for &(x, w) in &self.theta_rule {
+                    let h = Polar::from_tan2((2.0 * (w0 + (w1 - w0) * x)).exp());
+                    let az = azimuth(h);
+                    for k in 0..N {
+                        piece[k] += w * az[k] * lobe.density(h) * h.sin * h.cos;
+                    }
+                }
+                for k in 0..N {
+                    total[k] += piece[k] * (w1 - w0);
+                }
             }
         }
         // (1/2π) ∫∫ over the full circle = (1/π) ∫ over [0, π] by symmetry in φ.
-        total / PI
+        total.map(|t| t / PI)
     }
 
     /// Hemispherical average `E_avg = 2 ∫₀¹ E(μ) μ dμ`: the mean brightness of an evenly lit
@@ -211,9 +235,15 @@ impl AlbedoIntegrator {
         if glossy.microfacet.alpha <= 0.0 {
             return 1.0;
         }
+        self.hemispherical_average(|mu| self.directional_albedo(glossy, mu))
+    }
+
+    /// `2 ∫₀¹ f(μ) μ dμ` on the integrator's μ rule: the mean of a view-dependent albedo
+    /// `f` over an orthographic sphere.
+    pub fn hemispherical_average(&self, f: impl Fn(f64) -> f64) -> f64 {
         self.mu_rule
             .iter()
-            .map(|&(mu, w)| 2.0 * w * mu * self.directional_albedo(glossy, mu))
+            .map(|&(mu, w)| 2.0 * w * mu * f(mu))
             .sum()
     }
 

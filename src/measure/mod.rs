@@ -1,10 +1,13 @@
 //! ① Measure: the physics. The microfacet distributions (`microfacet`), the Glossy BSDF as
 //! Cycles evaluates it (`glossy`), its albedo by quadrature (`albedo`), the masking family of
 //! each Blender version (`version`), the normal a glossy BSDF shades with (`shading_normal`),
-//! and the classic BRDF set (`brdf`).
+//! the dielectric Fresnel (`fresnel`) and the coat of the layered shader (`coat`), and the
+//! classic BRDF set (`brdf`).
 
 pub mod albedo;
 pub mod brdf;
+pub mod coat;
+pub mod fresnel;
 pub mod glossy;
 pub mod microfacet;
 pub mod shading_normal;

@@ -14,7 +14,7 @@ use super::png::{
 };
 use crate::Error;
 use crate::verify::stats::RINGS;
-use crate::verify::{Rendered, Role, VerifyReport};
+use crate::verify::{Rendered, VerifyReport};
 
 /// The deviation at which the scale saturates: ±5 %.
 pub const SCALE: f64 = 0.05;
@@ -93,27 +93,18 @@ pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(
     register_font().map_err(|m| write_error(out, m))?;
     let plan = &rendered.plan;
     let cell = plan.settings.cell as usize;
-    let rows: Vec<_> = report
-        .rows
-        .iter()
-        .filter_map(|row| {
-            let index = plan.cells.iter().position(|c| {
-                c.role == Role::Corrected(row.distribution) && c.roughness == row.roughness
-            })?;
-            Some((row, index))
-        })
-        .collect();
-    let distributions: Vec<_> = {
-        let mut d: Vec<_> = rows.iter().map(|(r, _)| r.distribution).collect();
-        d.dedup();
-        d
+    let rows: Vec<_> = report.rows.iter().map(|row| (row, row.cells[1])).collect();
+    let series: Vec<String> = {
+        let mut s: Vec<_> = rows.iter().map(|(r, _)| r.series()).collect();
+        s.dedup();
+        s
     };
     let columns = plan.columns.max(1);
     let label_px = 14.0;
     let mut label_w = 0;
-    for d in &distributions {
+    for name in &series {
         label_w = label_w.max(
-            text_size(d.label(), label_px)
+            text_size(name, label_px)
                 .map_err(|e| write_error(out, e))?
                 .0,
         );
@@ -124,15 +115,15 @@ pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(
     let legend_h = 64;
     let grid_w = columns * (cell + gap);
     let w = (left + grid_w + pad).max(560);
-    let h = title_h + distributions.len() * (cell + gap) + legend_h;
+    let h = title_h + series.len() * (cell + gap) + legend_h;
     let mut rgb = vec![0u8; w * h * 3];
     for px in rgb.chunks_exact_mut(3) {
         px.copy_from_slice(&[LABEL_BACKGROUND.0, LABEL_BACKGROUND.1, LABEL_BACKGROUND.2]);
     }
     for (row, index) in &rows {
-        let k = distributions
+        let k = series
             .iter()
-            .position(|&d| d == row.distribution)
+            .position(|name| *name == row.series())
             .expect("listed above");
         let j = index % columns;
         let pixels = cell_image(rendered, *index, &row.ring_targets);
@@ -187,9 +178,9 @@ pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(
             left_mid,
             (pad, 38),
         )?;
-        for (k, d) in distributions.iter().enumerate() {
+        for (k, name) in series.iter().enumerate() {
             let y = title_h + k * (cell + gap) + cell / 2;
-            draw(d.label(), label_px, right_mid, (left - pad, y))?;
+            draw(name, label_px, right_mid, (left - pad, y))?;
         }
         let ticks = [-SCALE, -SCALE / 2.0, 0.0, SCALE / 2.0, SCALE];
         for t in ticks {

@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 
 use super::{deviation, png};
 use crate::verify::verdict::MIN_RING_PIXELS;
-use crate::verify::{Rendered, Role, VerifyReport};
+use crate::verify::{Rendered, VerifyReport, reference_label};
 
 /// The colours of the verdict banner (the browser test looks for them).
 pub const PASS_COLOUR: &str = "#1b7a2f";
@@ -73,7 +73,7 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         s,
         "<h2>Thresholds</h2><ul>\
          <li><b>tolerance</b> (<code>--tolerance</code>): every channel of a corrected sphere's mean within ±{} % of what the correction promises.</li>\
-         <li><b>ring tolerance</b> (<code>--ring-tolerance</code>, view and multiscatter modes): every view-cosine ring with at least {MIN_RING_PIXELS} fully covered pixels within ±{} %.</li>\
+         <li><b>ring tolerance</b> (<code>--ring-tolerance</code>, every mode but roughness): every view-cosine ring with at least {MIN_RING_PIXELS} fully covered pixels within ±{} %.</li>\
          <li>The false-colour thumbnails saturate at ±{} %.</li></ul>",
         report.tolerance_percent,
         report.ring_tolerance_percent,
@@ -93,34 +93,32 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         }
         s.push_str("</ul>\n");
     }
-    s.push_str(
-        "<h2>Spheres</h2><table><tr><th>status</th><th>sphere</th><th>uncorrected</th>\
-         <th>corrected</th><th>predicted</th><th>±SE</th><th>worst ring</th>\
-         <th>uncorrected</th><th>corrected</th><th>deviation</th></tr>\n",
+    // Layered mode compares the hand-made Mix Shader with the layered group.
+    let (plain, fixed) = match report.mode {
+        crate::generate::Mode::Layered => ("Mix Shader", "layered"),
+        _ => ("uncorrected", "corrected"),
+    };
+    let _ = writeln!(
+        s,
+        "<h2>Spheres</h2><table><tr><th>status</th><th>sphere</th><th>{plain}</th>\
+         <th>{fixed}</th><th>predicted</th><th>±SE</th><th>worst ring</th>\
+         <th>{plain}</th><th>{fixed}</th><th>deviation</th></tr>",
     );
     let plan = &rendered.plan;
     let cell = plan.settings.cell as usize;
-    let index_of = |role: Role, r: f64| {
-        plan.cells
-            .iter()
-            .position(|c| c.role == role && c.roughness == r)
+    let thumb = |i: usize| {
+        png_tag(
+            &png::cell_image(&rendered.image, plan.columns, cell, i),
+            cell,
+        )
     };
     let mut rows: Vec<_> = report.rows.iter().collect();
     rows.sort_by_key(|r| r.pass);
     for row in rows {
-        let thumb = |role: Role| {
-            index_of(role, row.roughness)
-                .map(|i| {
-                    png_tag(
-                        &png::cell_image(&rendered.image, plan.columns, cell, i),
-                        cell,
-                    )
-                })
-                .unwrap_or_default()
-        };
-        let false_colour = index_of(Role::Corrected(row.distribution), row.roughness)
-            .map(|i| png_tag(&deviation::cell_image(rendered, i, &row.ring_targets), cell))
-            .unwrap_or_default();
+        let false_colour = png_tag(
+            &deviation::cell_image(rendered, row.cells[1], &row.ring_targets),
+            cell,
+        );
         let (class, status) = if row.pass {
             ("ok", "ok")
         } else {
@@ -131,15 +129,15 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
             "<tr class=\"{class}\"><td class=\"{class}\">{status}</td><td class=\"name\">{} r = {}</td>\
              <td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td>\
              <td>{}</td><td>{}</td><td>{false_colour}</td></tr>",
-            row.distribution.label(),
+            escape(&row.series()),
             row.roughness,
             100.0 * row.uncorrected_brightness,
             100.0 * row.brightness,
             100.0 * row.predicted_corrected,
             100.0 * row.corrected.standard_error,
             100.0 * row.worst_ring,
-            thumb(Role::Uncorrected(row.distribution)),
-            thumb(Role::Corrected(row.distribution)),
+            thumb(row.cells[0]),
+            thumb(row.cells[1]),
         );
     }
     s.push_str("</table>\n");
@@ -150,22 +148,20 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         100.0 * deviation::SCALE
     );
     if !report.reference.is_empty() {
-        s.push_str(
-            "<h2>Reference: Blender's Multiscatter GGX</h2><table><tr><th>r</th><th>brightness</th><th>±SE</th><th>sphere</th></tr>\n",
+        let _ = writeln!(
+            s,
+            "<h2>Reference: Blender's {}</h2><table><tr><th>sphere</th><th>r</th><th>brightness</th><th>±SE</th><th>sphere</th></tr>",
+            reference_label(report.mode)
         );
         for r in &report.reference {
             let _ = writeln!(
                 s,
-                "<tr><td>{}</td><td>{:.2} %</td><td>{:.2} %</td><td>{}</td></tr>",
+                "<tr><td class=\"name\">{}</td><td>{}</td><td>{:.2} %</td><td>{:.2} %</td><td>{}</td></tr>",
+                escape(&r.series(report.mode)),
                 r.roughness,
                 100.0 * r.brightness,
                 100.0 * r.stats.standard_error,
-                index_of(Role::Reference, r.roughness)
-                    .map(|i| png_tag(
-                        &png::cell_image(&rendered.image, plan.columns, cell, i),
-                        cell
-                    ))
-                    .unwrap_or_default()
+                thumb(r.cell)
             );
         }
         s.push_str("</table>\n");

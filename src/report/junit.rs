@@ -39,7 +39,7 @@ pub fn render(report: &VerifyReport, rerun: &str) -> String {
         status
     };
     for row in &report.rows {
-        let sphere = format!("{} r={}", row.distribution.label(), row.roughness);
+        let sphere = format!("{} r={}", row.series(), row.roughness);
         let status = if row.deviation <= report.tolerance_percent / 100.0 {
             TestCaseStatus::success()
         } else {

@@ -41,7 +41,7 @@ pub fn write_files(
     })?;
     write_output(&exr_path, &bytes)?;
     let sheet = dir.join("contact-sheet.png");
-    let (rows, columns) = png::sheet_labels(&rendered.plan);
+    let (rows, columns) = png::sheet_labels(&rendered.plan, report.mode);
     png::contact_sheet(
         &rendered.image,
         rendered.plan.settings.cell as usize,

@@ -14,11 +14,12 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::Error;
+use crate::generate::Mode;
 use crate::measure::Distribution;
 use crate::output::write_output;
 use crate::verify::VerifyReport;
 use crate::verify::image::Rgba;
-use crate::verify::plan::{Plan, Role};
+use crate::verify::plan::{Plan, reference_label};
 
 /// Linear value of the background the spheres are composited over: 18 % grey, the
 /// photographic middle grey, so a sphere brighter or darker than 100 % stands out either way.
@@ -57,17 +58,17 @@ pub fn srgb8(linear: f32) -> u8 {
     (encoded * 255.0).round() as u8
 }
 
-/// Row and column labels of a plan's grid, for [`contact_sheet`]: `GGX uncorrected`,
-/// `GGX corrected`, …, `Multiscatter GGX`; the roughness values of the first row.
-pub fn sheet_labels(plan: &Plan) -> (Vec<String>, Vec<String>) {
+/// Row and column labels of a plan's grid in `mode`, for [`contact_sheet`]:
+/// `GGX uncorrected`, `GGX corrected`, …, `Multiscatter GGX` (layered mode: `GGX Mix
+/// Shader, IOR 1.5`, …); the roughness values of the first row.
+pub fn sheet_labels(plan: &Plan, mode: Mode) -> (Vec<String>, Vec<String>) {
     let columns = plan.columns.max(1);
     let rows = plan
         .cells
         .chunks(columns)
-        .map(|row| match row[0].role {
-            Role::Uncorrected(d) => format!("{} uncorrected", d.label()),
-            Role::Corrected(d) => format!("{} corrected", d.label()),
-            Role::Reference => "Multiscatter GGX".to_string(),
+        .map(|row| match row[0].ior {
+            Some(n) => format!("{}, IOR {n}", row[0].role.label(mode)),
+            None => row[0].role.label(mode),
         })
         .collect();
     let cols = plan
@@ -234,6 +235,15 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
     register_font().map_err(|m| write_error(out, m))?;
     let fail = |e: &dyn Display| write_error(out, format!("cannot draw the plot: {e}"));
 
+    // Layered sweeps plot one index of refraction (glass, 1.5, when it was rendered): the
+    // table, report.json and the zoomed panel below hold every index.
+    let plotted_ior = report.rows.iter().find_map(|r| r.ior).map(|first| {
+        if report.rows.iter().any(|r| r.ior == Some(1.5)) {
+            1.5
+        } else {
+            first
+        }
+    });
     let mut distributions: Vec<Distribution> = Vec::new();
     for row in &report.rows {
         if !distributions.contains(&row.distribution) {
@@ -243,7 +253,12 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
     let series: Vec<(Distribution, [Points; 4])> = distributions
         .iter()
         .map(|&d| {
-            let rows = || report.rows.iter().filter(move |r| r.distribution == d);
+            let rows = || {
+                report
+                    .rows
+                    .iter()
+                    .filter(move |r| r.distribution == d && r.ior == plotted_ior)
+            };
             let pts = |f: fn(&crate::verify::Row) -> f64| {
                 percent_points(rows().map(|r| (r.roughness, f(r))))
             };
@@ -258,7 +273,13 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             )
         })
         .collect();
-    let reference = percent_points(report.reference.iter().map(|s| (s.roughness, s.brightness)));
+    let reference = percent_points(
+        report
+            .reference
+            .iter()
+            .filter(|s| s.ior == plotted_ior)
+            .map(|s| (s.roughness, s.brightness)),
+    );
 
     let tolerance = if report.tolerance_percent.is_finite() {
         report.tolerance_percent.abs()
@@ -283,12 +304,22 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
     let x_pad = 0.02 * (x_hi - x_lo);
     let (x_lo, x_hi) = (x_lo - x_pad, x_hi + x_pad);
 
-    let title = format!(
-        "Furnace brightness · Blender {} · coefficients {} · {} spp",
-        report.render.blender_version,
-        shorten(&report.coefficients, 36),
-        report.render.samples
-    );
+    let title = match plotted_ior {
+        Some(n) => format!(
+            "Layered furnace brightness · Blender {} · IOR {n} · {} spp",
+            report.render.blender_version, report.render.samples
+        ),
+        None => format!(
+            "Furnace brightness · Blender {} · coefficients {} · {} spp",
+            report.render.blender_version,
+            shorten(&report.coefficients, 36),
+            report.render.samples
+        ),
+    };
+    let (uncorrected_name, corrected_name) = match report.mode {
+        Mode::Layered => ("Mix Shader", "layered"),
+        _ => ("uncorrected", "corrected"),
+    };
     // The zoomed panel: corrected spheres' distance from what they promise.
     let zoom: Vec<(Distribution, Points)> = distributions
         .iter()
@@ -373,16 +404,19 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             legend.push(Legend::Heading(d.label().to_string(), c));
             legend.push(Legend::Entry(
                 Key::Hollow(c),
-                "uncorrected, rendered".into(),
+                format!("{uncorrected_name}, rendered"),
             ));
             legend.push(Legend::Entry(
                 Key::Dashed(c.mix(0.6), 2),
-                "uncorrected, predicted".into(),
+                format!("{uncorrected_name}, predicted"),
             ));
-            legend.push(Legend::Entry(Key::Filled(c), "corrected, rendered".into()));
+            legend.push(Legend::Entry(
+                Key::Filled(c),
+                format!("{corrected_name}, rendered"),
+            ));
             legend.push(Legend::Entry(
                 Key::Solid(c.into()),
-                "corrected, predicted".into(),
+                format!("{corrected_name}, predicted"),
             ));
         }
         if !reference.is_empty() {
@@ -402,7 +436,7 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             legend.push(Legend::Heading("Reference".into(), REFERENCE_COLOUR));
             legend.push(Legend::Entry(
                 Key::Triangle(REFERENCE_COLOUR),
-                "Multiscatter GGX".into(),
+                reference_label(report.mode).into(),
             ));
         }
         // On top, so it shows through curves that lie on it.

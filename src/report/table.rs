@@ -33,16 +33,33 @@ pub fn render(report: &VerifyReport) -> String {
         i.render_seconds
     );
     let average = |v: [f64; 3]| v.iter().sum::<f64>() / 3.0;
+    let layered = report.mode == Mode::Layered;
+    // Layered rows name the index too ("Ashikhmin-Shirley, IOR 1.33"), and the references
+    // Principled BSDF.
+    let w = if layered { 30 } else { 18 };
+    if layered {
+        let _ = writeln!(
+            s,
+            "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of what the layered coat promises"
+        );
+    }
     let _ = writeln!(
         s,
-        "{:<18} {:>5} {:>12} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
-        "distribution", "r", "uncorrected", "corrected", "±SE", "predicted", "centre", "ring Δ"
+        "{:<w$} {:>5} {:>12} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
+        if layered { "coat" } else { "distribution" },
+        "r",
+        "uncorrected",
+        "corrected",
+        "±SE",
+        "predicted",
+        "centre",
+        "ring Δ"
     );
     for r in &report.rows {
         let _ = writeln!(
             s,
-            "{:<18} {:>5} {:>11.2}% {:>10.2}% {:>6.2}% {:>9.2}% {:>6.1}% {:>7.2}%  {}",
-            r.distribution.label(),
+            "{:<w$} {:>5} {:>11.2}% {:>10.2}% {:>6.2}% {:>9.2}% {:>6.1}% {:>7.2}%  {}",
+            r.series(),
             r.roughness,
             100.0 * r.uncorrected_brightness,
             100.0 * r.brightness,
@@ -56,8 +73,8 @@ pub fn render(report: &VerifyReport) -> String {
     for r in &report.reference {
         let _ = writeln!(
             s,
-            "{:<18} {:>5} {:>11.2}% {:>10} {:>6.2}% {:>10} {:>6.1}%  reference",
-            "Multiscatter GGX",
+            "{:<w$} {:>5} {:>11.2}% {:>10} {:>6.2}% {:>10} {:>6.1}%  reference",
+            r.series(report.mode),
             r.roughness,
             100.0 * r.brightness,
             "",

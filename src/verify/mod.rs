@@ -8,6 +8,7 @@ pub mod render;
 pub mod stats;
 pub mod verdict;
 
+pub use plan::reference_label;
 pub use plan::{Plan, RenderSettings, Role};
 pub use render::{RenderInfo, Rendered, render};
 pub use verdict::{Judging, ReferenceSphere, Row, Sweep, VerifyReport};
@@ -16,7 +17,7 @@ use crate::Error;
 use crate::blender::{Blender, BlenderOptions};
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{Distribution, Roughness};
+use crate::measure::{Distribution, Roughness, coat};
 use crate::progress::Progress;
 
 /// What `verify` renders and how it judges it.
@@ -28,6 +29,9 @@ pub struct VerifyOptions {
     pub distributions: Vec<Distribution>,
     /// The roughness values of the sweep, each once.
     pub roughness: Vec<Roughness>,
+    /// Layered mode: the coats' indices of refraction, each once, from 1 to
+    /// [`coat::IOR_MAX`] (every other mode: none).
+    pub ior: Vec<f64>,
     pub render: RenderSettings,
     pub mode: Mode,
     /// The spheres' colour (linear RGB, each in [0, 1]).
@@ -43,12 +47,24 @@ pub fn default_roughness() -> Vec<Roughness> {
     Roughness::grid(11)
 }
 
+/// The layered sweep's roughness values: 0.1, 0.25, 0.5, 0.75, 1 (a smooth coat is a
+/// mirror, which the table holds exactly).
+pub fn layered_roughness() -> Vec<Roughness> {
+    [0.1, 0.25, 0.5, 0.75, 1.0]
+        .map(|r| Roughness::new(r).expect("in [0, 1]"))
+        .to_vec()
+}
+
+/// The layered sweep's indices of refraction: water, glass, and a dense flint.
+pub const LAYERED_IOR: [f64; 3] = [1.33, 1.5, 2.0];
+
 impl Default for VerifyOptions {
     fn default() -> Self {
         VerifyOptions {
             coefficients: None,
             distributions: Vec::new(),
             roughness: default_roughness(),
+            ior: Vec::new(),
             render: RenderSettings::default(),
             mode: Mode::Roughness,
             color: [1.0; 3],
@@ -69,6 +85,7 @@ pub struct Verification {
 /// is looked for.
 pub fn verify(v: &VerifyOptions, progress: &dyn Progress) -> Result<Verification, Error> {
     check_roughness(&v.roughness)?;
+    check_ior(v.mode, &v.ior)?;
     check_color(v.color)?;
     if let Some(name) = &v.coefficients {
         distributions_of(v, &Coefficients::load(name)?, name)?;
@@ -84,11 +101,12 @@ pub fn verify_with(
     progress: &dyn Progress,
 ) -> Result<Verification, Error> {
     check_roughness(&v.roughness)?;
+    check_ior(v.mode, &v.ior)?;
     let (coefficients, source) =
         Coefficients::load_or_preset(v.coefficients.as_deref(), blender.version)?;
     let distributions = distributions_of(v, &coefficients, &source)?;
     let roughness: Vec<f64> = v.roughness.iter().map(|r| r.get()).collect();
-    let plan = Plan::verify(&distributions, &roughness, v.render);
+    let plan = Plan::verify(&distributions, &roughness, &v.ior, v.render);
     let curves = Curves::Pinned {
         coefficients: &coefficients,
         name: &source,
@@ -113,6 +131,7 @@ pub fn verify_with(
         source: &source,
         distributions: &distributions,
         roughness: &roughness,
+        ior: &v.ior,
         mode: v.mode,
         color: v.color,
         color_model: v.color_model,
@@ -132,6 +151,39 @@ pub fn check_color(color: [f64; 3]) -> Result<(), Error> {
         &text.join(","),
         "three linear values from 0 to 1, e.g. 0.95,0.64,0.54",
     ))
+}
+
+/// Layered mode needs indices of refraction, each once and within the coat tables; every
+/// other mode takes none.
+fn check_ior(mode: Mode, ior: &[f64]) -> Result<(), Error> {
+    if mode != Mode::Layered {
+        return match ior.first() {
+            Some(n) => Err(Error::input(
+                "--ior",
+                &n.to_string(),
+                "no index of refraction: --ior goes with --mode layered",
+            )),
+            None => Ok(()),
+        };
+    }
+    if ior.is_empty() {
+        return Err(Error::input(
+            "--ior",
+            "",
+            "at least one index of refraction for --mode layered",
+        ));
+    }
+    for (i, n) in ior.iter().enumerate() {
+        let range = 1.0..=coat::IOR_MAX;
+        if !range.contains(n) || ior[..i].contains(n) {
+            return Err(Error::input(
+                "--ior",
+                &n.to_string(),
+                &format!("each index once, from 1 to {}", coat::IOR_MAX),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {

@@ -1,6 +1,8 @@
 //! What one Blender process renders: a grid of furnace spheres, one per cell, row-major with
 //! row 0 at the top. Each distribution gets an uncorrected row and a corrected row; a final
-//! row holds Blender's own energy-conserving Multiscatter GGX as the reference.
+//! row holds Blender's own energy-conserving answer as the reference. In layered mode the
+//! rows repeat for every index of refraction, "uncorrected" is the Mix Shader artists build
+//! by hand and the reference is Principled BSDF.
 
 use serde::Serialize;
 use std::path::Path;
@@ -12,18 +14,43 @@ use crate::measure::Distribution;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case", tag = "kind", content = "distribution")]
 pub enum Role {
-    /// The plain Glossy BSDF of that distribution.
+    /// The plain Glossy BSDF of that distribution (layered mode: Mix Shader with a Fresnel
+    /// factor over Diffuse and that Glossy).
     Uncorrected(Distribution),
-    /// The `Gloffuse (…)` shader group: the corrected Glossy BSDF.
+    /// The mode's gloffuse shader group of that distribution.
     Corrected(Distribution),
-    /// Plain Glossy with `MULTI_GGX`, Blender's energy-conserving GGX.
+    /// Blender's own energy-conserving answer: Glossy with `MULTI_GGX` (layered mode:
+    /// Principled BSDF).
     Reference,
+}
+
+impl Role {
+    /// How a report names the spheres of this role in `mode`.
+    pub fn label(self, mode: Mode) -> String {
+        match (self, mode) {
+            (Role::Uncorrected(d), Mode::Layered) => format!("{} Mix Shader", d.label()),
+            (Role::Corrected(d), Mode::Layered) => format!("{} layered", d.label()),
+            (Role::Uncorrected(d), _) => format!("{} uncorrected", d.label()),
+            (Role::Corrected(d), _) => format!("{} corrected", d.label()),
+            (Role::Reference, _) => reference_label(mode).to_string(),
+        }
+    }
+}
+
+/// The reference spheres' shader in `mode`.
+pub fn reference_label(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Layered => "Principled BSDF",
+        _ => "Multiscatter GGX",
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
     pub role: Role,
     pub roughness: f64,
+    /// The coat's index of refraction (layered mode only).
+    pub ior: Option<f64>,
 }
 
 /// Render settings with their reasons.
@@ -60,22 +87,33 @@ pub struct Plan {
 
 impl Plan {
     /// The verify sweep: for each distribution (in `groups` order) an uncorrected row and a
-    /// corrected row over `roughness`, then the Multiscatter GGX reference row.
+    /// corrected row over `roughness`, then the reference row; all of it once per index in
+    /// `ior` (layered mode), or once with no index when `ior` is empty.
     pub fn verify(
         distributions: &[Distribution],
         roughness: &[f64],
+        ior: &[f64],
         settings: RenderSettings,
     ) -> Self {
+        let iors: Vec<Option<f64>> = if ior.is_empty() {
+            vec![None]
+        } else {
+            ior.iter().copied().map(Some).collect()
+        };
         let mut cells = Vec::new();
-        for &d in distributions {
-            for role in [Role::Uncorrected(d), Role::Corrected(d)] {
-                cells.extend(roughness.iter().map(|&r| Cell { role, roughness: r }));
+        for ior in iors {
+            let roles = distributions
+                .iter()
+                .flat_map(|&d| [Role::Uncorrected(d), Role::Corrected(d)])
+                .chain([Role::Reference]);
+            for role in roles {
+                cells.extend(roughness.iter().map(|&r| Cell {
+                    role,
+                    roughness: r,
+                    ior,
+                }));
             }
         }
-        cells.extend(roughness.iter().map(|&r| Cell {
-            role: Role::Reference,
-            roughness: r,
-        }));
         Plan {
             cells,
             columns: roughness.len(),
@@ -95,6 +133,7 @@ impl Plan {
                 roughness.iter().map(move |&r| Cell {
                     role: Role::Uncorrected(d),
                     roughness: r,
+                    ior: None,
                 })
             })
             .collect();
@@ -107,6 +146,13 @@ impl Plan {
 
     pub fn rows(&self) -> usize {
         self.cells.len().div_ceil(self.columns)
+    }
+
+    /// The index of the cell of `role` at roughness `r` and index `ior`.
+    pub fn find(&self, role: Role, r: f64, ior: Option<f64>) -> Option<usize> {
+        self.cells
+            .iter()
+            .position(|c| c.role == role && c.roughness == r && c.ior == ior)
     }
 
     /// The parameter document for `furnace_main.py` (the groups plus the furnace section).
@@ -130,18 +176,28 @@ impl Plan {
         let spheres = self
             .cells
             .iter()
-            .map(|c| match c.role {
-                Role::Uncorrected(d) => SphereSpec::Plain {
+            .map(|c| match (c.role, c.ior) {
+                (Role::Uncorrected(d), Some(ior)) => SphereSpec::Mix {
+                    distribution: d.blender_enum(),
+                    roughness: c.roughness,
+                    ior,
+                },
+                (Role::Uncorrected(d), None) => SphereSpec::Plain {
                     distribution: d.blender_enum(),
                     roughness: c.roughness,
                 },
-                Role::Reference => SphereSpec::Plain {
+                (Role::Reference, Some(ior)) => SphereSpec::Principled {
+                    roughness: c.roughness,
+                    ior,
+                },
+                (Role::Reference, None) => SphereSpec::Plain {
                     distribution: "MULTI_GGX",
                     roughness: c.roughness,
                 },
-                Role::Corrected(d) => SphereSpec::Group {
+                (Role::Corrected(d), ior) => SphereSpec::Group {
                     group: shader_of(d),
                     roughness: c.roughness,
+                    ior,
                 },
             })
             .collect();
@@ -172,7 +228,17 @@ pub enum SphereSpec {
     Group {
         group: String,
         roughness: f64,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        ior: Option<f64>,
     },
+    /// Mix Shader(Fac = Fresnel(ior), Diffuse, white Glossy of `distribution`).
+    Mix {
+        distribution: &'static str,
+        roughness: f64,
+        ior: f64,
+    },
+    /// Principled BSDF at its defaults, a dielectric of index `ior`.
+    Principled { roughness: f64, ior: f64 },
 }
 
 #[derive(Clone, Debug, Serialize)]

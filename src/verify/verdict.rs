@@ -9,7 +9,8 @@ use super::stats::SphereStats;
 use crate::Error;
 use crate::fit::{Coefficients, ColorSpace, preset_for};
 use crate::generate::{ColorModel, Mode};
-use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Glossy, Roughness};
+use crate::measure::coat::Coat;
+use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Glossy, Roughness, fresnel};
 
 /// Rings with fewer fully covered pixels than this are too noisy to judge flatness by (at
 /// 64 px per sphere, the outermost ring, μ ∈ [0.3, 0.4), holds 72 pixels: at 32 spp its
@@ -37,11 +38,18 @@ impl Default for Judging {
     }
 }
 
-/// One distribution at one roughness: the plain Glossy sphere and the corrected one.
+/// One distribution at one roughness: the plain Glossy sphere and the corrected one (layered
+/// mode: at one index of refraction, the hand-made Mix Shader and the layered group).
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
     pub distribution: Distribution,
     pub roughness: f64,
+    /// The coat's index of refraction (layered mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ior: Option<f64>,
+    /// Where the uncorrected and the corrected sphere are in the plan's cells.
+    #[serde(skip)]
+    pub cells: [usize; 2],
     pub uncorrected: SphereStats,
     pub corrected: SphereStats,
     /// What the colour model promises the corrected sphere's mean is, per channel: the
@@ -54,7 +62,8 @@ pub struct Row {
     pub brightness: f64,
     /// The worst channel's |mean / target − 1|.
     pub deviation: f64,
-    /// The integrator's E_avg(r) for this Blender's masking (0–1).
+    /// What the integrator predicts for the uncorrected sphere: E_avg(r) for this Blender's
+    /// masking (0–1); in layered mode the Mix Shader's mean relative to `target`.
     pub predicted_uncorrected: f64,
     /// What the coefficients should give relative to `target` (gain(r) · E_avg(r) for a
     /// white sphere; 1 in the view modes).
@@ -70,13 +79,42 @@ pub struct Row {
     pub pass: bool,
 }
 
-/// Blender's Multiscatter GGX at one roughness (the energy-conserving peer).
+/// `GGX`, or in layered mode `GGX, IOR 1.5`: the name of a row's series.
+fn series_name(name: &str, ior: Option<f64>) -> String {
+    match ior {
+        Some(n) => format!("{name}, IOR {n}"),
+        None => name.to_string(),
+    }
+}
+
+impl Row {
+    /// The distribution, and the index of refraction in layered mode: `GGX, IOR 1.5`.
+    pub fn series(&self) -> String {
+        series_name(self.distribution.label(), self.ior)
+    }
+}
+
+/// Blender's Multiscatter GGX at one roughness (the energy-conserving peer; layered mode:
+/// Principled BSDF at one index of refraction).
 #[derive(Clone, Debug, Serialize)]
 pub struct ReferenceSphere {
     pub roughness: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ior: Option<f64>,
+    /// Where the sphere is in the plan's cells.
+    #[serde(skip)]
+    pub cell: usize,
     pub stats: SphereStats,
-    /// Its mean relative to what the colour model promises a GGX sphere, channels averaged.
+    /// Its mean relative to what the colour model promises a GGX sphere (layered mode: a
+    /// layered GGX coat), channels averaged.
     pub brightness: f64,
+}
+
+impl ReferenceSphere {
+    /// `Multiscatter GGX`, or in layered mode `Principled BSDF, IOR 1.5`.
+    pub fn series(&self, mode: Mode) -> String {
+        series_name(super::plan::reference_label(mode), self.ior)
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -116,6 +154,8 @@ pub struct Sweep<'a> {
     pub source: &'a str,
     pub distributions: &'a [Distribution],
     pub roughness: &'a [f64],
+    /// Layered mode: the indices of refraction (else empty).
+    pub ior: &'a [f64],
     pub mode: Mode,
     /// The spheres' colour and what a correction promises for it.
     pub color: [f64; 3],
@@ -148,9 +188,15 @@ fn relative(measured: [f64; 3], target: [f64; 3]) -> (f64, f64) {
     (ratios.iter().sum::<f64>() / 3.0, worst)
 }
 
-/// The mean of E over a view-cosine ring [lo, hi) of an orthographic sphere, whose pixels
-/// have view-cosine density ∝ μ: `∫ E μ dμ / ∫ μ dμ` by 4-point Gauss–Legendre.
-fn ring_albedo(integrator: &AlbedoIntegrator, glossy: &Glossy, (lo, hi): (f64, f64)) -> f64 {
+/// What a layered surface of base colour `C` reflects where its coat reflects `a`:
+/// `a + C (1 − a)` per channel.
+fn layered_target(color: [f64; 3], a: f64) -> [f64; 3] {
+    color.map(|c| a + c * (1.0 - a))
+}
+
+/// The mean of an albedo `f(μ)` over a view-cosine ring [lo, hi) of an orthographic sphere,
+/// whose pixels have view-cosine density ∝ μ: `∫ f μ dμ / ∫ μ dμ` by 4-point Gauss–Legendre.
+fn ring_mean(f: impl Fn(f64) -> f64, (lo, hi): (f64, f64)) -> f64 {
     const NODES: [(f64, f64); 4] = [
         (0.069_431_844_202_973_7, 0.173_927_422_568_726_9),
         (0.330_009_478_207_571_9, 0.326_072_577_431_273_1),
@@ -160,7 +206,7 @@ fn ring_albedo(integrator: &AlbedoIntegrator, glossy: &Glossy, (lo, hi): (f64, f
     let (mut num, mut den) = (0.0, 0.0);
     for (x, w) in NODES {
         let mu = lo + (hi - lo) * x;
-        num += w * mu * integrator.directional_albedo(glossy, mu.max(1e-4));
+        num += w * mu * f(mu.max(1e-4));
         den += w * mu;
     }
     num / den
@@ -180,6 +226,7 @@ pub fn judge(
         source,
         distributions,
         roughness,
+        ior,
         mode,
         color,
         color_model,
@@ -188,74 +235,136 @@ pub fn judge(
     let masking = version.masking();
     let integrator = AlbedoIntegrator::default();
     let tolerance = judging.tolerance_percent / 100.0;
-    let find = |role: Role, r: f64| {
-        plan.cells
-            .iter()
-            .position(|c| c.role == role && c.roughness == r)
-            .map(|i| rendered.stats[i].clone())
-            .expect("the plan holds every role at every roughness")
+    let find = |role: Role, r: f64, ior: Option<f64>| {
+        plan.find(role, r, ior)
+            .expect("the plan holds every role at every roughness and index")
+    };
+    let iors: Vec<Option<f64>> = if ior.is_empty() {
+        vec![None]
+    } else {
+        ior.iter().copied().map(Some).collect()
     };
     let mut rows = Vec::new();
-    for &d in distributions {
-        let curve = &coefficients.distributions[&d].curve;
+    for &ior in &iors {
+        for &d in distributions {
+            let curve = &coefficients.distributions[&d].curve;
+            for &r in roughness {
+                let glossy = Glossy::new(d, masking, Roughness::new(r)?);
+                let e_avg = integrator.average_albedo(&glossy);
+                let cells = [
+                    find(Role::Uncorrected(d), r, ior),
+                    find(Role::Corrected(d), r, ior),
+                ];
+                let [uncorrected, corrected] = cells.map(|i| rendered.stats[i].clone());
+                let coat = ior.map(|n| Coat::new(&integrator, glossy, n));
+                // What the sphere promises as a whole and ring by ring (every pixel's target:
+                // shown in every mode, judged in the per-pixel modes).
+                let (target, ring_targets): ([f64; 3], Vec<[f64; 3]>) = match &coat {
+                    Some(coat) => (
+                        layered_target(
+                            color,
+                            integrator.hemispherical_average(|mu| coat.albedo(mu)),
+                        ),
+                        corrected
+                            .rings
+                            .iter()
+                            .map(|ring| {
+                                layered_target(color, ring_mean(|mu| coat.albedo(mu), ring.mu))
+                            })
+                            .collect(),
+                    ),
+                    None => (
+                        target(color_model, color, e_avg, e_avg),
+                        corrected
+                            .rings
+                            .iter()
+                            .map(|ring| {
+                                let e = ring_mean(
+                                    |mu| integrator.directional_albedo(&glossy, mu),
+                                    ring.mu,
+                                );
+                                self::target(color_model, color, e_avg, e)
+                            })
+                            .collect(),
+                    ),
+                };
+                let (brightness, deviation) = relative(corrected.mean_rgb, target);
+                let worst_ring = worst_ring(&corrected, &ring_targets);
+                let rings_flat =
+                    !mode.per_pixel() || worst_ring <= judging.ring_tolerance_percent / 100.0;
+                // What the roughness-only gain g gives: C g E_avg (exact), or
+                // C E_avg / (1 − C (1 − 1/g)) (physical).
+                let achieved = |c: f64| match color_model {
+                    ColorModel::Exact => c * curve.gain(r) * e_avg,
+                    ColorModel::Physical => c * e_avg / (1.0 - c * (1.0 - 1.0 / curve.gain(r))),
+                };
+                let predicted_uncorrected = match &coat {
+                    // The hand-made Mix Shader: F E + (1 − F) C, averaged over the sphere.
+                    Some(coat) => {
+                        let mix = color.map(|c| {
+                            integrator.hemispherical_average(|mu| coat.hand_mix_albedo(mu, c))
+                        });
+                        relative(mix, target).0
+                    }
+                    None => e_avg,
+                };
+                rows.push(Row {
+                    distribution: d,
+                    roughness: r,
+                    ior,
+                    cells,
+                    uncorrected_brightness: relative(
+                        uncorrected.mean_rgb,
+                        if coat.is_some() { target } else { color },
+                    )
+                    .0,
+                    uncorrected,
+                    pass: deviation <= tolerance && rings_flat,
+                    deviation,
+                    worst_ring,
+                    ring_targets,
+                    brightness,
+                    target,
+                    corrected,
+                    predicted_uncorrected,
+                    predicted_corrected: match mode {
+                        Mode::Roughness => relative(color.map(achieved), target).0,
+                        Mode::View | Mode::Multiscatter | Mode::Layered => 1.0,
+                    },
+                });
+            }
+        }
+    }
+    let mut reference = Vec::new();
+    for &ior in &iors {
         for &r in roughness {
-            let glossy = Glossy::new(d, masking, Roughness::new(r)?);
-            let e_avg = integrator.average_albedo(&glossy);
-            let target = target(color_model, color, e_avg, e_avg);
-            let corrected = find(Role::Corrected(d), r);
-            let uncorrected = find(Role::Uncorrected(d), r);
-            let (brightness, deviation) = relative(corrected.mean_rgb, target);
-            // Every pixel's target: shown in every mode, judged in the view modes.
-            let ring_targets: Vec<[f64; 3]> = corrected
-                .rings
-                .iter()
-                .map(|ring| {
-                    let e = ring_albedo(&integrator, &glossy, ring.mu);
-                    self::target(color_model, color, e_avg, e)
-                })
-                .collect();
-            let worst_ring = worst_ring(&corrected, &ring_targets);
-            let rings_flat =
-                mode == Mode::Roughness || worst_ring <= judging.ring_tolerance_percent / 100.0;
-            // What the roughness-only gain g gives: C g E_avg (exact), or
-            // C E_avg / (1 − C (1 − 1/g)) (physical).
-            let achieved = |c: f64| match color_model {
-                ColorModel::Exact => c * curve.gain(r) * e_avg,
-                ColorModel::Physical => c * e_avg / (1.0 - c * (1.0 - 1.0 / curve.gain(r))),
+            let ggx = Glossy::new(Distribution::Ggx, masking, Roughness::new(r)?);
+            // Multiscatter GGX promises what a corrected GGX sphere does; Principled BSDF
+            // what a layered GGX coat does.
+            let promise = match ior {
+                Some(n) => {
+                    let coat = Coat::new(&integrator, ggx, n);
+                    layered_target(
+                        color,
+                        integrator.hemispherical_average(|mu| coat.albedo(mu)),
+                    )
+                }
+                None => {
+                    let e_avg = integrator.average_albedo(&ggx);
+                    target(color_model, color, e_avg, e_avg)
+                }
             };
-            rows.push(Row {
-                distribution: d,
+            let cell = find(Role::Reference, r, ior);
+            let stats = rendered.stats[cell].clone();
+            reference.push(ReferenceSphere {
                 roughness: r,
-                uncorrected_brightness: relative(uncorrected.mean_rgb, color).0,
-                uncorrected,
-                pass: deviation <= tolerance && rings_flat,
-                deviation,
-                worst_ring,
-                ring_targets,
-                brightness,
-                target,
-                corrected,
-                predicted_uncorrected: e_avg,
-                predicted_corrected: match mode {
-                    Mode::Roughness => relative(color.map(achieved), target).0,
-                    Mode::View | Mode::Multiscatter => 1.0,
-                },
+                ior,
+                cell,
+                brightness: relative(stats.mean_rgb, promise).0,
+                stats,
             });
         }
     }
-    let reference = roughness
-        .iter()
-        .map(|&r| {
-            let ggx = Glossy::new(Distribution::Ggx, masking, Roughness::new(r)?);
-            let e_avg = integrator.average_albedo(&ggx);
-            let stats = find(Role::Reference, r);
-            Ok(ReferenceSphere {
-                roughness: r,
-                brightness: relative(stats.mean_rgb, target(color_model, color, e_avg, e_avg)).0,
-                stats,
-            })
-        })
-        .collect::<Result<_, Error>>()?;
     let pass = rows.iter().all(|r| r.pass);
     let mut notes = Vec::new();
     for (d, e) in &coefficients.distributions {
@@ -270,6 +379,18 @@ pub fn judge(
                 preset_for(version)
             ));
         }
+    }
+    // Before 4.0 Principled's specular F0 is 0.08 × Specular, and Specular stops at 1.
+    let capped: Vec<String> = ior
+        .iter()
+        .filter(|&&n| version.major < 4 && fresnel::f0(n) > 0.08 + 1e-12)
+        .map(|n| n.to_string())
+        .collect();
+    if !capped.is_empty() {
+        notes.push(format!(
+            "Blender {version}'s Principled BSDF cannot reflect like a coat of IOR {}: its specular F0 is 0.08 × Specular and Specular stops at 1 (F0 0.08, IOR 1.79), so those reference spheres use Specular 1.",
+            capped.join(", ")
+        ));
     }
     if coefficients
         .distributions

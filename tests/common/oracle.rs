@@ -10,8 +10,20 @@ use std::f64::consts::{FRAC_PI_2, PI};
 /// `Glossy::eval_cos` (so it shares nothing with the integrator but the BSDF itself).
 /// Ashikhmin–Shirley is integrated as Cycles samples it (see `cycles_ashikhmin_shirley`).
 pub fn brute_force_albedo(glossy: &Glossy, mu: f64, nx: usize, nphi: usize) -> f64 {
+    brute_force_weighted(glossy, mu, nx, nphi, &|_| 1.0)
+}
+
+/// [`brute_force_albedo`] with every direction weighted by `weight(ωo·h)` (a Fresnel term
+/// at the microfacet: for Ashikhmin–Shirley, at |ωo·h| of Cycles' sampled h).
+pub fn brute_force_weighted(
+    glossy: &Glossy,
+    mu: f64,
+    nx: usize,
+    nphi: usize,
+    weight: &dyn Fn(f64) -> f64,
+) -> f64 {
     if glossy.distribution() == gloffuse::measure::Distribution::AshikhminShirley {
-        return cycles_ashikhmin_shirley(glossy, mu, nx, nphi);
+        return cycles_ashikhmin_shirley(glossy, mu, nx, nphi, weight);
     }
     let wo = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let a = glossy.microfacet.alpha.max(1e-4);
@@ -32,7 +44,7 @@ pub fn brute_force_albedo(glossy: &Glossy, mu: f64, nx: usize, nphi: usize) -> f
                 continue;
             }
             let wi = 2.0 * od * h - wo;
-            ring += glossy.eval_cos(wo, wi) * 4.0 * od;
+            ring += glossy.eval_cos(wo, wi) * 4.0 * od * weight(od);
         }
         sum += ring * st * dtheta;
     }
@@ -45,7 +57,13 @@ pub fn brute_force_albedo(glossy: &Glossy, mu: f64, nx: usize, nphi: usize) -> f
 /// direction `−ωo + 2 d h_flipped` (not a unit vector for flipped samples); eval and pdf both
 /// use H = normalize(ωo + ωi) and |H·ωo|: eval = cosθi (n+1)/(8π) (N·H)ⁿ / (|H·ωo| max(cosθi, μ)),
 /// pdf = (n+1)/(8π) (N·H)ⁿ / |H·ωo|; a zero pdf discards the sample.
-pub fn cycles_ashikhmin_shirley(glossy: &Glossy, mu: f64, nx: usize, nphi: usize) -> f64 {
+pub fn cycles_ashikhmin_shirley(
+    glossy: &Glossy,
+    mu: f64,
+    nx: usize,
+    nphi: usize,
+    weight: &dyn Fn(f64) -> f64,
+) -> f64 {
     let wo = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let n = glossy.microfacet.ashikhmin_shirley_exponent();
     let norm = (n + 1.0) / (8.0 * PI);
@@ -74,7 +92,7 @@ pub fn cycles_ashikhmin_shirley(glossy: &Glossy, mu: f64, nx: usize, nphi: usize
             let pdf = norm * lobe / h_dot_view;
             if pdf > 0.0 {
                 let eval = wi.z * norm * lobe / (h_dot_view * wi.z.max(mu));
-                ring += eval / pdf;
+                ring += eval / pdf * weight(d.abs());
             }
         }
         sum += ring * density;

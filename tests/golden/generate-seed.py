@@ -10,7 +10,7 @@ GLOFFUSE_PARAMS = "{\"gloffuse_version\":\"0.1.0\",\"height_correlated_from\":[3
 #
 # One part of the script the gloffuse binary concatenates: header
 # (GLOFFUSE_PARAMS), compat.py, params.py, nodes.py, roughness_groups.py,
-# normal_group.py, view_groups.py, groups.py, runtime.py, then a main (generate_main.py or
+# normal_group.py, view_groups.py, layered_groups.py, groups.py, runtime.py, then a main (generate_main.py or
 # furnace_main.py). It defines functions and constants only.
 # ---------------------------------------------------------------------------
 import bpy
@@ -312,13 +312,25 @@ def compat_disable_post_processing(render):
         if hasattr(render, name):
             setattr(render, name, False)
 
+
+def compat_principled_dielectric(node, ior):
+    """Make a Principled BSDF (otherwise at its defaults) a dielectric of index
+    `ior`. In 4.0+ its specular layer follows IOR (Specular IOR Level 0.5 keeps
+    it as is). Before 4.0 IOR drives transmission only; the specular F0 is
+    0.08 x Specular, so Specular = F0(ior) / 0.08 -- capped at 1 (F0 = 0.08,
+    IOR 1.79) by the socket."""
+    node.inputs["IOR"].default_value = ior
+    if "Specular" in node.inputs:
+        f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+        node.inputs["Specular"].default_value = min(f0 / 0.08, 1.0)
+
 # ======== gloffuse part: params.py ========
 # ---------------------------------------------------------------------------
 # gloffuse params.py: checks the parameter document (GLOFFUSE_PARAMS) before
 # anything is built, and says what is wrong with it.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; uses
 # max_name_bytes() from compat.py.
 #
@@ -407,6 +419,12 @@ def resolve_params(document):
             view["image"] = family.get("image")
             view["table"] = family.get("table")
             group["view"] = view
+        if spec.get("layered_group") is not None:
+            group["layered"] = {
+                "shader_group": spec["layered_group"],
+                "image": family.get("image"), "table": family.get("table"),
+                "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
+            }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
     params["groups"] = resolved
@@ -450,6 +468,19 @@ def validate_params(params):
             if not isinstance(table, dict) or not all(
                     isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("width", "height")):
                 raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
+        layered = spec.get("layered")
+        if layered is not None:
+            views = True
+            if not isinstance(layered, dict):
+                raise ValueError("%s.layered must be an object" % where)
+            _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
+            for key in ("image", "coat_image"):
+                _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
+            coat = layered.get("coat_table")
+            if not isinstance(coat, dict) or not all(
+                    isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
+                raise ValueError("%s.layered.coat_table needs integer size and slices of at "
+                                 "least 2" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))
@@ -480,7 +511,7 @@ def load_params(text):
 # frames and descriptions.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; every version
 # difference it meets goes through compat.py.
 # ---------------------------------------------------------------------------
@@ -794,7 +825,7 @@ def asset_fields(params, kind):
 # curve) and the shader group (a Glossy BSDF whose colour goes through it).
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only.
 #
 #   build_correction_group(spec, params) -> correction tree
@@ -1047,7 +1078,7 @@ def build_glossy_group(name, spec, params, correction_tree, description, tags, s
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
 # params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# groups.py, runtime.py, then a main. Functions and constants only.
+# layered_groups.py, groups.py, runtime.py, then a main. Functions and constants only.
 # ---------------------------------------------------------------------------
 import bpy
 
@@ -1230,7 +1261,7 @@ def normal_group_node(tree, normal_tree, group_in, location, frame=None):
 # Fms = C E_avg / (1 - C (1 - E_avg)), colour C (1 + Fms (1 - E) / E).
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and constants only; the socket lists
 # below extend roughness_groups.py's.
 # ---------------------------------------------------------------------------
@@ -1267,7 +1298,16 @@ def albedo_image(view):
     average = finite_list(table["average"], "view.table.average")
     if len(average) != width:
         raise ValueError("view.table.average holds %d values, not %d" % (len(average), width))
-    name = view["image"]
+    pixels = []
+    for index, value in enumerate(values):
+        pixels.extend((value, average[index % width], value, value))
+    return packed_float_image(view["image"], width, height, pixels)
+
+
+def packed_float_image(name, width, height, pixels):
+    """A non-colour, channel-packed 32-bit float image packed into the .blend:
+    reused by name (resized if needed) and filled with `pixels` (RGBA, bottom
+    row first)."""
     image = bpy.data.images.get(name)
     if image is not None and tuple(image.size) != (width, height):
         image.scale(width, height)
@@ -1275,9 +1315,6 @@ def albedo_image(view):
         image = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
     image.colorspace_settings.name = "Non-Color"
     image.alpha_mode = "CHANNEL_PACKED"
-    pixels = []
-    for index, value in enumerate(values):
-        pixels.extend((value, average[index % width], value, value))
     image.pixels.foreach_set(pixels)
     image.update()
     image.file_format = "OPEN_EXR"
@@ -1488,14 +1525,187 @@ def build_multiscatter_group(spec, params):
                asset_fields(params, "shader"))
     return tree
 
+# ======== gloffuse part: layered_groups.py ========
+# ---------------------------------------------------------------------------
+# gloffuse layered_groups.py: "Gloffuse Layered (...)", a dielectric glossy
+# coat over a diffuse base (spec["layered"]).
+#
+# The coat reflects A(mu, r, IOR): the albedo of the distribution's lobe with
+# the exact dielectric Fresnel at each microfacet, plus the energy single
+# scattering loses, tinted as Kulla and Conty (and Blender 4.x's Multiscatter
+# GGX) do. Blender's Glossy BSDF reflects E(mu, r) of white light, so the coat
+# is that Glossy with colour Specular Tint x A / E; the base is a Diffuse BSDF
+# of colour Base Color x (1 - A). With a white base the surface reflects
+# E (A / E) + (1 - A) = 1: everything, at every roughness, view and index.
+#
+# A travels as one packed float image: slices side by side, slice k for the
+# index whose z = F0^(1/4) is k z_max / (K - 1), each slice a grid over (r, mu)
+# read at pixel centres; the group reads the two slices around its IOR and
+# mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
+# from the shading-normal group (normal_group.py).
+#
+# One part of the script the gloffuse binary concatenates, after
+# view_groups.py (whose albedo_lookup it uses). Functions and constants only.
+# ---------------------------------------------------------------------------
+
+LAYERED_IOR_MIN = 1.0
+LAYERED_IOR_MAX = 3.0
+
+
+def layered_sockets():
+    """Base Color, Roughness, IOR, Specular Tint, Normal [, Bump Map Correction] -> BSDF."""
+    return [
+        {"in_out": "INPUT", "name": "Base Color", "type": "NodeSocketColor",
+         "default": (0.8, 0.8, 0.8, 1.0), "description": "Colour of the diffuse base"},
+        {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
+         "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness of the coat (0..1)"},
+        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
+         "default": 1.5, "min": LAYERED_IOR_MIN, "max": LAYERED_IOR_MAX,
+         "description": "Index of refraction of the coat (1 = no coat)"},
+        {"in_out": "INPUT", "name": "Specular Tint", "type": "NodeSocketColor",
+         "default": (1.0, 1.0, 1.0, 1.0),
+         "description": "Tint of the coat's reflection (the base still gets 1 - A)"},
+        NORMAL_INPUT,
+    ] + bump_map_correction_inputs() + [
+        {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
+         "description": "Glossy coat plus diffuse base; a white base reflects everything"},
+    ]
+
+
+def coat_image(layered):
+    """The packed float image of A(mu, r, IOR).
+    Row i is mu = i / (size - 1) (bottom row first); slice k fills columns
+    k size .. (k + 1) size - 1, column j of it r = j / (size - 1). A is stored in
+    every channel."""
+    table = layered["coat_table"]
+    size, slices = int(table["size"]), int(table["slices"])
+    width = size * slices
+    values = finite_list(table["values"], "layered.coat_table.values")
+    if len(values) != width * size:
+        raise ValueError("layered.coat_table holds %d values, not %d x %d"
+                         % (len(values), width, size))
+    pixels = []
+    for value in values:
+        pixels.extend((value, value, value, value))
+    return packed_float_image(layered["coat_image"], width, size, pixels)  # view_groups.py
+
+
+def coat_lookup(tree, layered, chain, roughness, mu, ior, x, frame):
+    """Nodes that read A(mu, r, IOR): the two slices around the index, mixed
+    linearly in z = F0^(1/4). Returns the A socket."""
+    table = layered["coat_table"]
+    size, slices = int(table["size"]), int(table["slices"])
+    z_max = float(table["z_max"])
+    # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4), for n clamped to the table's range.
+    n = chain.math("MINIMUM", "n = min(IOR, %g)" % LAYERED_IOR_MAX,
+                   chain.math("MAXIMUM", "max(IOR, 1)", ior, LAYERED_IOR_MIN), LAYERED_IOR_MAX)
+    ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
+                       chain.math("ADD", "n + 1", n, 1.0))
+    z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
+    s = chain.math("MULTIPLY", "slice position z (K-1) / z_max", z, (slices - 1) / z_max)
+    k0 = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
+                    slices - 2.0)
+    t = chain.math("SUBTRACT", "t = position - k", s, k0)
+    # Pixel centres of slice k: u = (k W + 1/2 + r (W - 1)) / (K W); the next slice is 1/K on.
+    within = chain.math("MULTIPLY_ADD", "r (W-1) + 1/2", roughness, size - 1.0, 0.5)
+    u0 = chain.math("DIVIDE", "u of slice k",
+                    chain.math("MULTIPLY_ADD", "k W + r (W-1) + 1/2", k0, float(size), within),
+                    float(size * slices))
+    u1 = chain.math("ADD", "u of slice k + 1", u0, 1.0 / slices)
+    v = chain.math("MULTIPLY_ADD", "v = mu (H-1)/H + 1/2H", mu, (size - 1.0) / size, 0.5 / size)
+    image = coat_image(layered)
+    samples = []
+    for index, u in enumerate((u0, u1)):
+        uv = tree.nodes.new("ShaderNodeCombineXYZ")
+        uv.name = "uv %d" % index
+        set_parent(uv, frame)
+        uv.location = (FRAME_INSET + COLUMN_STEP * x, -ROW_STEP * (4 + 2 * index))
+        tree.links.new(u, uv.inputs["X"])
+        tree.links.new(v, uv.inputs["Y"])
+        texture = tree.nodes.new("ShaderNodeTexImage")
+        texture.name = "A(mu, r) slice %s" % ("k", "k + 1")[index]
+        texture.label = short_label("coat A(mu, r, IOR) %d x %d x %d, slice %s"
+                                    % (size, size, slices, ("k", "k + 1")[index]))
+        texture.image = image
+        texture.interpolation = "Linear"
+        texture.extension = "EXTEND"
+        texture.width = 240.0
+        set_parent(texture, frame)
+        texture.location = (FRAME_INSET + COLUMN_STEP * (x + 1), -ROW_STEP * (4 + 2 * index))
+        tree.links.new(uv.outputs[0], texture.inputs["Vector"])
+        samples.append(texture.outputs["Alpha"])
+    chain.column = max(chain.column, x + 3)
+    difference = chain.math("SUBTRACT", "A(k + 1) - A(k)", samples[1], samples[0])
+    return chain.math("MULTIPLY_ADD", "A = A(k) + t (A(k + 1) - A(k))", difference, t, samples[0],
+                      name="Coat albedo")
+
+
+def build_layered_group(spec, params):
+    """Base Color, Roughness, IOR, Specular Tint, Normal -> BSDF: Glossy(Specular
+    Tint x A / E) + Diffuse(Base Color x (1 - A))."""
+    layered = spec["layered"]
+    tree = reuse_or_create_group(layered["shader_group"])
+    ensure_interface(tree, layered_sockets())
+    nodes, links = tree.nodes, tree.links
+    group_in = nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+    frame = new_frame(tree, "Coat frame",
+                      "Coat albedo A(mu, r, IOR) and E(mu, r), mu at the shaded normal")
+    r = clamped_roughness(tree, group_in, frame)
+    mu = view_cosine(tree, params, group_in, 1, frame)
+    albedo, _e_avg, column = albedo_lookup(tree, layered, r, mu, 2, frame)
+    chain = Chain(tree, frame, column=column, y=0.0)
+    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], column, frame)
+    weight = chain.math("DIVIDE", "A / E", a, albedo, name="Coat weight")
+    glossy_color = chain.vector("SCALE", "Specular Tint × A / E", group_in.outputs["Specular Tint"],
+                                weight, name="Coat colour")
+    base = chain.math("SUBTRACT", "1 - A", 1.0, a, name="Base weight")
+    base_color = chain.vector("SCALE", "Base Color × (1 - A)", group_in.outputs["Base Color"],
+                              base, name="Base colour")
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1)
+    glossy = glossy_node(nodes, spec["distribution"])
+    glossy.name = "Glossy BSDF"
+    glossy.label = short_label("Coat: Glossy BSDF (%s)" % spec["distribution"])
+    glossy.width = NODE_WIDTH
+    glossy.location = (x, 200.0)
+    links.new(glossy_color, glossy.inputs["Color"])
+    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
+    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.name = "Diffuse BSDF"
+    diffuse.label = "Base: Diffuse BSDF"
+    diffuse.width = NODE_WIDTH
+    diffuse.location = (x, -ROW_STEP)
+    links.new(base_color, diffuse.inputs["Color"])
+    links.new(group_in.outputs["Normal"], diffuse.inputs["Normal"])
+    add = nodes.new("ShaderNodeAddShader")
+    add.name = "Coat + base"
+    add.location = (x + COLUMN_STEP, 0.0)
+    links.new(glossy.outputs[0], add.inputs[0])
+    links.new(diffuse.outputs[0], add.inputs[1])
+    group_out = nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    links.new(add.outputs[0], group_out.inputs["BSDF"])
+    description = description_text(spec, params, (
+        "Glossy %s coat over a diffuse base: the coat reflects A(mu, r, IOR), the albedo of "
+        "a dielectric microfacet coat with its lost energy given back (Kulla-Conty, as "
+        "Multiscatter GGX), read from the packed table '%s'; the base gets Base Color x "
+        "(1 - A). A white base reflects 100 %% at every roughness, view and IOR. mu is read "
+        "at the normal the glossy BSDF shades with (see '%s')."
+        % (spec["distribution"], layered["coat_image"], params["normal_group"])))
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "layered"],
+               asset_fields(params, "shader"))
+    return tree
+
 # ======== gloffuse part: groups.py ========
 # ---------------------------------------------------------------------------
 # gloffuse groups.py: build_all(params), the order in which every node group
 # of the parameter document is built.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
-# runtime.py, then a main. Functions only.
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
+# layered_groups.py, groups.py, runtime.py, then a main. Functions only.
 #
 #   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
 #                                                     params.py's resolve_params)
@@ -1504,8 +1714,8 @@ def build_multiscatter_group(spec, params):
 def build_all(params):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
-    with spec["view"] the view pair and/or the multiscatter group it names, after
-    the shared normal group they use. Returns [(spec, [trees...]), ...] in
+    with spec["view"] the view pair and/or the multiscatter group it names, and
+    with spec["layered"] the layered group, after the shared normal group they use. Returns [(spec, [trees...]), ...] in
     document order; the normal group comes first with the first view spec."""
     validate_params(params)
     built = []
@@ -1524,6 +1734,11 @@ def build_all(params):
                 trees.append(build_view_shader_group(spec, params, view_correction))
             if view.get("multiscatter_group"):
                 trees.append(build_multiscatter_group(spec, params))
+        if spec.get("layered"):
+            if normal_tree is None:
+                normal_tree = build_normal_group(params)
+                trees.insert(0, normal_tree)
+            trees.append(build_layered_group(spec, params))
         built.append((spec, trees))
     return built
 
@@ -1535,7 +1750,7 @@ def build_all(params):
 # Blender.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, groups.py,
+# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
 # runtime.py, then a main. Functions and classes only.
 #
 #   script_args(argv=None) -> the arguments meant for the script
@@ -1751,7 +1966,8 @@ def _render_group(scene, mesh, tree, path, made):
     node_tree.nodes.clear()
     group = node_tree.nodes.new("ShaderNodeGroup")
     group.node_tree = tree
-    group.inputs["Color"].default_value = PREVIEW_COLOR
+    color_input = "Color" if "Color" in group.inputs else "Base Color"  # layered groups
+    group.inputs[color_input].default_value = PREVIEW_COLOR
     group.inputs["Roughness"].default_value = PREVIEW_ROUGHNESS
     output = node_tree.nodes.new("ShaderNodeOutputMaterial")
     node_tree.links.new(group.outputs["BSDF"], output.inputs["Surface"])
@@ -1779,9 +1995,11 @@ def render_previews(built, params, directory):
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
             view = spec.get("view") or {}
+            layered = spec.get("layered") or {}
             pairs = [(spec["shader_group"], [spec["correction_group"]]),
                      (view.get("shader_group"), [view.get("correction_group")]),
-                     (view.get("multiscatter_group"), [])]
+                     (view.get("multiscatter_group"), []),
+                     (layered.get("shader_group"), [])]
             for shader_name, helpers in pairs:
                 tree = by_name.get(shader_name)
                 if tree is None:
@@ -1794,8 +2012,9 @@ def render_previews(built, params, directory):
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
             normal = by_name.get(params.get("normal_group"))
-            if normal is not None and view.get("shader_group") in shown:
-                _set_preview(normal, shown[view["shader_group"]])
+            first_view = view.get("shader_group") or layered.get("shader_group")
+            if normal is not None and first_view in shown:
+                _set_preview(normal, shown[first_view])
     finally:
         # One batch: removing a mesh one by one would take its object with it first.
         bpy.data.batch_remove(made)
@@ -1816,7 +2035,7 @@ def render_previews(built, params, directory):
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
 # Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
 # params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# groups.py and runtime.py, and previews.py.
+# layered_groups.py, groups.py and runtime.py, and previews.py.
 # ---------------------------------------------------------------------------
 import sys  # also imported by runtime.py; repeated so this file reads on its own
 import tempfile

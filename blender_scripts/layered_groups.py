@@ -1,0 +1,171 @@
+# ---------------------------------------------------------------------------
+# gloffuse layered_groups.py: "Gloffuse Layered (...)", a dielectric glossy
+# coat over a diffuse base (spec["layered"]).
+#
+# The coat reflects A(mu, r, IOR): the albedo of the distribution's lobe with
+# the exact dielectric Fresnel at each microfacet, plus the energy single
+# scattering loses, tinted as Kulla and Conty (and Blender 4.x's Multiscatter
+# GGX) do. Blender's Glossy BSDF reflects E(mu, r) of white light, so the coat
+# is that Glossy with colour Specular Tint x A / E; the base is a Diffuse BSDF
+# of colour Base Color x (1 - A). With a white base the surface reflects
+# E (A / E) + (1 - A) = 1: everything, at every roughness, view and index.
+#
+# A travels as one packed float image: slices side by side, slice k for the
+# index whose z = F0^(1/4) is k z_max / (K - 1), each slice a grid over (r, mu)
+# read at pixel centres; the group reads the two slices around its IOR and
+# mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
+# from the shading-normal group (normal_group.py).
+#
+# One part of the script the gloffuse binary concatenates, after
+# view_groups.py (whose albedo_lookup it uses). Functions and constants only.
+# ---------------------------------------------------------------------------
+
+LAYERED_IOR_MIN = 1.0
+LAYERED_IOR_MAX = 3.0
+
+
+def layered_sockets():
+    """Base Color, Roughness, IOR, Specular Tint, Normal [, Bump Map Correction] -> BSDF."""
+    return [
+        {"in_out": "INPUT", "name": "Base Color", "type": "NodeSocketColor",
+         "default": (0.8, 0.8, 0.8, 1.0), "description": "Colour of the diffuse base"},
+        {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
+         "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness of the coat (0..1)"},
+        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
+         "default": 1.5, "min": LAYERED_IOR_MIN, "max": LAYERED_IOR_MAX,
+         "description": "Index of refraction of the coat (1 = no coat)"},
+        {"in_out": "INPUT", "name": "Specular Tint", "type": "NodeSocketColor",
+         "default": (1.0, 1.0, 1.0, 1.0),
+         "description": "Tint of the coat's reflection (the base still gets 1 - A)"},
+        NORMAL_INPUT,
+    ] + bump_map_correction_inputs() + [
+        {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
+         "description": "Glossy coat plus diffuse base; a white base reflects everything"},
+    ]
+
+
+def coat_image(layered):
+    """The packed float image of A(mu, r, IOR).
+    Row i is mu = i / (size - 1) (bottom row first); slice k fills columns
+    k size .. (k + 1) size - 1, column j of it r = j / (size - 1). A is stored in
+    every channel."""
+    table = layered["coat_table"]
+    size, slices = int(table["size"]), int(table["slices"])
+    width = size * slices
+    values = finite_list(table["values"], "layered.coat_table.values")
+    if len(values) != width * size:
+        raise ValueError("layered.coat_table holds %d values, not %d x %d"
+                         % (len(values), width, size))
+    pixels = []
+    for value in values:
+        pixels.extend((value, value, value, value))
+    return packed_float_image(layered["coat_image"], width, size, pixels)  # view_groups.py
+
+
+def coat_lookup(tree, layered, chain, roughness, mu, ior, x, frame):
+    """Nodes that read A(mu, r, IOR): the two slices around the index, mixed
+    linearly in z = F0^(1/4). Returns the A socket."""
+    table = layered["coat_table"]
+    size, slices = int(table["size"]), int(table["slices"])
+    z_max = float(table["z_max"])
+    # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4), for n clamped to the table's range.
+    n = chain.math("MINIMUM", "n = min(IOR, %g)" % LAYERED_IOR_MAX,
+                   chain.math("MAXIMUM", "max(IOR, 1)", ior, LAYERED_IOR_MIN), LAYERED_IOR_MAX)
+    ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
+                       chain.math("ADD", "n + 1", n, 1.0))
+    z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
+    s = chain.math("MULTIPLY", "slice position z (K-1) / z_max", z, (slices - 1) / z_max)
+    k0 = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
+                    slices - 2.0)
+    t = chain.math("SUBTRACT", "t = position - k", s, k0)
+    # Pixel centres of slice k: u = (k W + 1/2 + r (W - 1)) / (K W); the next slice is 1/K on.
+    within = chain.math("MULTIPLY_ADD", "r (W-1) + 1/2", roughness, size - 1.0, 0.5)
+    u0 = chain.math("DIVIDE", "u of slice k",
+                    chain.math("MULTIPLY_ADD", "k W + r (W-1) + 1/2", k0, float(size), within),
+                    float(size * slices))
+    u1 = chain.math("ADD", "u of slice k + 1", u0, 1.0 / slices)
+    v = chain.math("MULTIPLY_ADD", "v = mu (H-1)/H + 1/2H", mu, (size - 1.0) / size, 0.5 / size)
+    image = coat_image(layered)
+    samples = []
+    for index, u in enumerate((u0, u1)):
+        uv = tree.nodes.new("ShaderNodeCombineXYZ")
+        uv.name = "uv %d" % index
+        set_parent(uv, frame)
+        uv.location = (FRAME_INSET + COLUMN_STEP * x, -ROW_STEP * (4 + 2 * index))
+        tree.links.new(u, uv.inputs["X"])
+        tree.links.new(v, uv.inputs["Y"])
+        texture = tree.nodes.new("ShaderNodeTexImage")
+        texture.name = "A(mu, r) slice %s" % ("k", "k + 1")[index]
+        texture.label = short_label("coat A(mu, r, IOR) %d x %d x %d, slice %s"
+                                    % (size, size, slices, ("k", "k + 1")[index]))
+        texture.image = image
+        texture.interpolation = "Linear"
+        texture.extension = "EXTEND"
+        texture.width = 240.0
+        set_parent(texture, frame)
+        texture.location = (FRAME_INSET + COLUMN_STEP * (x + 1), -ROW_STEP * (4 + 2 * index))
+        tree.links.new(uv.outputs[0], texture.inputs["Vector"])
+        samples.append(texture.outputs["Alpha"])
+    chain.column = max(chain.column, x + 3)
+    difference = chain.math("SUBTRACT", "A(k + 1) - A(k)", samples[1], samples[0])
+    return chain.math("MULTIPLY_ADD", "A = A(k) + t (A(k + 1) - A(k))", difference, t, samples[0],
+                      name="Coat albedo")
+
+
+def build_layered_group(spec, params):
+    """Base Color, Roughness, IOR, Specular Tint, Normal -> BSDF: Glossy(Specular
+    Tint x A / E) + Diffuse(Base Color x (1 - A))."""
+    layered = spec["layered"]
+    tree = reuse_or_create_group(layered["shader_group"])
+    ensure_interface(tree, layered_sockets())
+    nodes, links = tree.nodes, tree.links
+    group_in = nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+    frame = new_frame(tree, "Coat frame",
+                      "Coat albedo A(mu, r, IOR) and E(mu, r), mu at the shaded normal")
+    r = clamped_roughness(tree, group_in, frame)
+    mu = view_cosine(tree, params, group_in, 1, frame)
+    albedo, _e_avg, column = albedo_lookup(tree, layered, r, mu, 2, frame)
+    chain = Chain(tree, frame, column=column, y=0.0)
+    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], column, frame)
+    weight = chain.math("DIVIDE", "A / E", a, albedo, name="Coat weight")
+    glossy_color = chain.vector("SCALE", "Specular Tint × A / E", group_in.outputs["Specular Tint"],
+                                weight, name="Coat colour")
+    base = chain.math("SUBTRACT", "1 - A", 1.0, a, name="Base weight")
+    base_color = chain.vector("SCALE", "Base Color × (1 - A)", group_in.outputs["Base Color"],
+                              base, name="Base colour")
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1)
+    glossy = glossy_node(nodes, spec["distribution"])
+    glossy.name = "Glossy BSDF"
+    glossy.label = short_label("Coat: Glossy BSDF (%s)" % spec["distribution"])
+    glossy.width = NODE_WIDTH
+    glossy.location = (x, 200.0)
+    links.new(glossy_color, glossy.inputs["Color"])
+    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
+    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.name = "Diffuse BSDF"
+    diffuse.label = "Base: Diffuse BSDF"
+    diffuse.width = NODE_WIDTH
+    diffuse.location = (x, -ROW_STEP)
+    links.new(base_color, diffuse.inputs["Color"])
+    links.new(group_in.outputs["Normal"], diffuse.inputs["Normal"])
+    add = nodes.new("ShaderNodeAddShader")
+    add.name = "Coat + base"
+    add.location = (x + COLUMN_STEP, 0.0)
+    links.new(glossy.outputs[0], add.inputs[0])
+    links.new(diffuse.outputs[0], add.inputs[1])
+    group_out = nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    links.new(add.outputs[0], group_out.inputs["BSDF"])
+    description = description_text(spec, params, (
+        "Glossy %s coat over a diffuse base: the coat reflects A(mu, r, IOR), the albedo of "
+        "a dielectric microfacet coat with its lost energy given back (Kulla-Conty, as "
+        "Multiscatter GGX), read from the packed table '%s'; the base gets Base Color x "
+        "(1 - A). A white base reflects 100 %% at every roughness, view and IOR. mu is read "
+        "at the normal the glossy BSDF shades with (see '%s')."
+        % (spec["distribution"], layered["coat_image"], params["normal_group"])))
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "layered"],
+               asset_fields(params, "shader"))
+    return tree
