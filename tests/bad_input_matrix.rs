@@ -474,6 +474,15 @@ fn cases() -> Vec<Case> {
             "invalid --distribution 'ashikhmin-shirley'",
             "the coefficients 'seed' hold: beckmann, ggx",
         ]),
+        case(&["verify", "--ior", "1.5"])
+            .no_blender()
+            .says(&["invalid --ior '1.5'", "--ior goes with --mode layered"]),
+        case(&["verify", "--mode", "layered", "--ior", "0.5"])
+            .no_blender()
+            .says(&["'0.5' is not an index of refraction from 1 to 3"]),
+        case(&["verify", "--mode", "layered", "--ior", "1.5,1.5"])
+            .no_blender()
+            .says(&["invalid --ior '1.5'", "each index once"]),
         case(&["verify", "--spp", "0"])
             .no_blender()
             .says(&["'0' for '--spp", "1..=65536"]),
