@@ -50,7 +50,7 @@
 //! # Speed
 //!
 //! Each row runs every texel through f32 kernels with eight explicit accumulator lanes
-//! (flushed to f64 per azimuth, per block of tail nodes, every 512 classic samples). The
+//! (flushed to f64 per azimuth, per 512 tail nodes, every 512 classic samples). The
 //! lanes fix the order of the sum, so the result is bit-identical whether the kernel runs as
 //! SSE2 or AVX2 code (chosen at run time; no FMA) and for any thread count. Rows run in
 //! parallel (rayon). The f32 kernels stay within 2e-7 of the same rule in f64
@@ -381,8 +381,8 @@ struct QuadraturePixel {
     lv: f32,
     /// The masking weight's factor in the pole piece (ue4: `G1(V)/G1_Smith(V)`;
     /// height-correlated: `2(1 + Λ(V))`) and in the tail (ue4: `G1(V)`; height-correlated: 2).
-    c_pole: f32,
-    c_tail: f32,
+    c_pole: f64,
+    c_tail: f64,
 }
 
 impl QuadraturePixel {
@@ -411,8 +411,8 @@ impl QuadraturePixel {
             b: p.b as f32,
             k: k as f32,
             lv: lv as f32,
-            c_pole: c_pole as f32,
-            c_tail: c_tail as f32,
+            c_pole,
+            c_tail,
         }
     }
 
@@ -479,7 +479,7 @@ fn quadrature_kernel<const HC: bool>(
             }
         }
         // dθn = 2 de/(1 + e²); the visible-normal density's normalisation.
-        let f = 2.0 * e1_64 * az.weight * texel.norm * f64::from(p.c_pole);
+        let f = 2.0 * e1_64 * az.weight * texel.norm * p.c_pole;
         total_scale += lanes_sum(&scale) * f;
         total_bias += lanes_sum(&bias) * f;
     }
@@ -515,7 +515,7 @@ fn quadrature_kernel<const HC: bool>(
         tail_scale += lanes_sum(&scale);
         tail_bias += lanes_sum(&bias);
     }
-    let f = alpha * alpha / PI * f64::from(p.c_tail);
+    let f = alpha * alpha / PI * p.c_tail;
     (total_scale + tail_scale * f, total_bias + tail_bias * f)
 }
 
