@@ -4,7 +4,8 @@
 //! * the same quadrature with a fine rule (64 nodes per piece), over every texel;
 //! * the fine rule in plain f64 on a subset of texels (every 8th texel, every other texel of
 //!   the three most grazing rows and of the two smoothest columns), itself checked against
-//!   the plain-f64 visible-normal estimator with 2²⁰ samples (no shared code) on every 8th
+//!   the plain-f64 visible-normal estimator with 2²⁰ samples (it shares only the masking
+//!   formula) on every 8th
 //!   texel of that subset;
 //! * for height-correlated G, `scale + bias` against the Cycles-exact albedo quadrature
 //!   (`AlbedoIntegrator`, fine rules), which shares no code with the LUT.

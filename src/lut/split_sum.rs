@@ -42,8 +42,9 @@
 //!   views, so at 1024 samples it is off by up to 1e-2 near `N·V = 0` (measured:
 //!   `cargo bench --bench lut`).
 //!
-//! [`split_sum_texel_sampled`] is a third, slow estimator in plain f64 that shares no code
-//! with the other two: the classic one, or GGX's visible normals sampled with centred
+//! [`split_sum_texel_sampled`] is a third, slow estimator in plain f64 that shares no
+//! integration code with the quadrature (only the masking formula [`g`]): the classic
+//! estimator, or GGX's visible normals sampled with centred
 //! Hammersley points on Heitz's disk (pdf `G1(V) max(0, V·H) D(H) / N·V`, weight
 //! `G/G1(V)`). The tests and the bench use it as the independent reference.
 //!
@@ -753,7 +754,7 @@ pub enum Sampler {
 
 /// One texel estimated in plain f64, sample by sample, from the textbook formulas (with the
 /// full 3-vectors, no shortcuts): `(scale, bias)` at roughness `r` and `N·V = nov`. Slow;
-/// it shares no code with the quadrature: a cross-check of the classic kernel and, with
+/// it shares only [`g`] with the quadrature: a cross-check of the classic kernel and, with
 /// visible normals and many samples, an independent reference for the quadrature.
 pub fn split_sum_texel_sampled(
     r: f64,
