@@ -517,6 +517,16 @@ fn lut_bad_input_exits_2_and_writes_nothing() {
             "--distribution",
         ),
         (&["--bits", "8", "--out", "t.exr"], "--bits"),
+        // The default split-sum method is quadrature: it takes no samples.
+        (&["--samples", "64", "--out", "t.exr"], "--samples"),
+        (
+            &["--method", "visible-normals", "--out", "t.exr"],
+            "--method",
+        ),
+        (
+            &["--kind", "albedo", "--method", "classic", "--out", "t.exr"],
+            "--method",
+        ),
         (&["--out", "missing/t.exr"], "missing"),
     ];
     for (args, named) in cases {

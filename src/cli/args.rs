@@ -11,7 +11,7 @@ use gloffuse::bench::BenchOptions;
 use gloffuse::blender::{BlenderOptions, InstallerOutput};
 use gloffuse::fit::{Point, Target, Weighting};
 use gloffuse::generate::{ColorModel, GenerateOptions, Mode};
-use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Sampling};
+use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Method};
 use gloffuse::measure::brdf::{Model, ModelParams};
 use gloffuse::measure::{BlenderVersion, Distribution, Roughness};
 use gloffuse::refresh::RefreshOptions;
@@ -222,13 +222,13 @@ const G_MODELS: &[Choice<GModel>] = &[
     ),
 ];
 
-const SAMPLINGS: &[Choice<Sampling>] = &[
+const METHODS: &[Choice<Method>] = &[
     choice(
-        Sampling::VisibleNormals,
-        "GGX visible normals (Heitz 2018): bounded weights, 1e-3 at 2048 samples",
+        Method::Quadrature,
+        "deterministic Gauss–Legendre quadrature cut at the horizon of L: within 5e-5",
     ),
     choice(
-        Sampling::Classic,
+        Method::Classic,
         "the textbook (UE4) estimator to the letter: H ~ D·N·H; up to 1e-2 off near grazing at 1024",
     ),
 ];
@@ -749,13 +749,13 @@ pub struct LutArgs {
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
 
-    /// Hammersley samples per texel, 1 to 1048576 [default: 2048 split-sum (max error 7e-4), 4096 kulla-conty; albedo takes none: it is quadrature].
+    /// Hammersley samples per texel, 1 to 1048576, for kulla-conty [default: 4096] and split-sum --method classic [default: 2048]; split-sum's quadrature and albedo take none.
     #[arg(long, value_name = "N")]
     pub samples: Option<u32>,
 
-    /// split-sum only: visible-normals (accurate) or classic (the textbook UE4 estimator verbatim) [default: visible-normals].
-    #[arg(long, value_parser = one_of(SAMPLINGS, Sampling::key))]
-    pub sampling: Option<Sampling>,
+    /// split-sum only: quadrature (deterministic, max error 5e-5) or classic (the textbook UE4 estimator verbatim, sampled) [default: quadrature].
+    #[arg(long, value_parser = one_of(METHODS, Method::key))]
+    pub method: Option<Method>,
 
     /// Bits per channel: 16 (half float) or 32 (float).
     #[arg(long, value_parser = one_of(BITS, Bits::key), default_value = Bits::Half.key())]
@@ -786,7 +786,7 @@ impl LutArgs {
             blender_version: self.blender_version,
             size: self.size,
             samples: self.samples,
-            sampling: self.sampling,
+            method: self.method,
             bits: self.bits,
             g_model: self.g_model,
             format: self.format,

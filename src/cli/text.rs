@@ -90,8 +90,8 @@ pub fn lut(s: &LutSummary) -> String {
     if let Some(g) = s.g_model {
         how.push(format!("{} masking", g.key()));
     }
-    if let Some(m) = s.sampling {
-        how.push(format!("{} sampling", m.key()));
+    if s.method == Some(gloffuse::lut::Method::Classic) {
+        how.push("classic (UE4) estimator".to_string());
     }
     if let Some(d) = s.distribution {
         how.push(format!("{d}"));

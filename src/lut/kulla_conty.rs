@@ -164,8 +164,8 @@ pub fn fms_sampled(glossy: &Glossy, mu: f64, samples: u32, e_column: &[f64], e_a
 /// One texel's `(scale, bias)`: `(1/N) Σ (1 − Fc) w` and `(1/N) Σ Fc w` with Cycles' sample
 /// weight w, for view cosine `mu`.
 ///
-/// GGX samples its visible normals (Heitz 2018, the same centred Hammersley disk as the
-/// split-sum table), weight `G2(μ, μi) / G1(μ) = G2 (1 + Λ(μ))`. Beckmann and
+/// GGX samples its visible normals (Heitz 2018, the same centred Hammersley disk as
+/// [`super::split_sum::split_sum_texel_sampled`]), weight `G2(μ, μi) / G1(μ) = G2 (1 + Λ(μ))`. Beckmann and
 /// Ashikhmin–Shirley sample `D cosθh` / `(n + 1)/(2π) cosⁿθh` at Hammersley points
 /// `(u, v)`, `φ = 2πu`, with Cycles' weights `G2 V·H / (N·H μ)` and `cosθi / max(cosθi, μ)`
 /// (Ashikhmin–Shirley flips a back-facing h after taking V·H, as Cycles does).

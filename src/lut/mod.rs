@@ -12,10 +12,9 @@
 //!
 //! * [`Kind::SplitSum`], 2 channels: **R = scale, G = bias**, the classic GGX "BRDF
 //!   generator" (see [`split_sum`]); at run time `specular = F0 · scale + bias`. By default
-//!   sampled with GGX's visible normals at 2048 samples: 512² in about 0.37 s (ue4) /
-//!   0.45 s (height-correlated) on 2 cores, within 7.2e-4 of the converged table
-//!   (`cargo bench --bench lut`); `--sampling classic` is the textbook estimator verbatim
-//!   (1e-2 off near grazing at 1024 samples).
+//!   computed by deterministic quadrature (no samples): 512² within 2.2e-5 of the converged
+//!   table (`cargo bench --bench lut`); `--method classic` is the textbook estimator
+//!   verbatim, with `--samples` (1e-2 off near grazing at 1024 samples).
 //! * [`Kind::Albedo`], 2 channels, for the same Glossy BSDF: **R = E(μ, r)** and
 //!   **G = E_avg(r)** (constant along each column), both by the deterministic quadrature of
 //!   [`crate::measure::AlbedoIntegrator`] (no samples; max error 3.2e-5): the two
@@ -108,22 +107,23 @@ impl GModel {
     }
 }
 
-/// How the split-sum integral is sampled (both estimate the same integral; see
+/// How the split-sum integral is computed (both compute the same integral; see
 /// [`split_sum`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum Sampling {
-    /// GGX visible normals (Heitz 2018): bounded weights, 1e-3 at 2048 samples.
-    VisibleNormals,
-    /// The textbook (UE4) estimator to the letter: H ~ D·N·H; up to 1e-2 off near grazing at 1024.
+pub enum Method {
+    /// Deterministic Gauss–Legendre quadrature cut at the horizon of L: within 5e-5.
+    Quadrature,
+    /// The textbook (UE4) estimator to the letter: H ~ D·N·H, N Hammersley samples; up to
+    /// 1e-2 off near grazing at 1024.
     Classic,
 }
 
-impl Sampling {
+impl Method {
     pub fn key(self) -> &'static str {
         match self {
-            Sampling::VisibleNormals => "visible-normals",
-            Sampling::Classic => "classic",
+            Method::Quadrature => "quadrature",
+            Method::Classic => "classic",
         }
     }
 }
@@ -201,10 +201,11 @@ pub struct LutOptions {
     pub blender_version: Option<BlenderVersion>,
     /// Texels per side [default: 512 split-sum, 64 otherwise].
     pub size: Option<u32>,
-    /// Hammersley samples per texel [default: 2048 split-sum, 4096 kulla-conty].
+    /// Hammersley samples per texel: kulla-conty [default: 4096] and split-sum with
+    /// [`Method::Classic`] [default: 2048]; the quadrature and albedo take none.
     pub samples: Option<u32>,
-    /// split-sum only [default: visible normals].
-    pub sampling: Option<Sampling>,
+    /// split-sum only [default: quadrature].
+    pub method: Option<Method>,
     pub bits: Bits,
     /// split-sum only [default: ue4].
     pub g_model: Option<GModel>,
@@ -223,7 +224,7 @@ impl LutOptions {
             blender_version: None,
             size: None,
             samples: None,
-            sampling: None,
+            method: None,
             bits: Bits::Half,
             g_model: None,
             format: None,
@@ -268,9 +269,8 @@ impl Table {
 pub enum Spec {
     SplitSum {
         size: usize,
-        samples: u32,
         g_model: GModel,
-        sampling: Sampling,
+        estimate: split_sum::Estimate,
     },
     KullaConty {
         size: usize,
@@ -342,11 +342,23 @@ impl Spec {
                         "nothing with --kind split-sum (choose its masking with --g-model; --blender-version applies to kulla-conty)",
                     ));
                 }
+                let estimate = match args.method.unwrap_or(Method::Quadrature) {
+                    Method::Quadrature => {
+                        if let Some(n) = args.samples {
+                            return Err(Error::input(
+                                "--samples",
+                                &n.to_string(),
+                                "nothing with --kind split-sum's default --method quadrature (it is deterministic quadrature, not sampled; --samples applies to --method classic)",
+                            ));
+                        }
+                        split_sum::Estimate::Quadrature(split_sum::Rule::default())
+                    }
+                    Method::Classic => split_sum::Estimate::Classic { samples },
+                };
                 Ok(Spec::SplitSum {
                     size,
-                    samples,
                     g_model: args.g_model.unwrap_or(GModel::Ue4),
-                    sampling: args.sampling.unwrap_or(Sampling::VisibleNormals),
+                    estimate,
                 })
             }
             Kind::KullaConty | Kind::Albedo | Kind::Coat => {
@@ -360,11 +372,11 @@ impl Spec {
                         ),
                     ));
                 }
-                if let Some(s) = args.sampling {
+                if let Some(m) = args.method {
                     return Err(Error::input(
-                        "--sampling",
-                        s.key(),
-                        &format!("nothing with --kind {kind} (--sampling applies to split-sum)"),
+                        "--method",
+                        m.key(),
+                        &format!("nothing with --kind {kind} (--method applies to split-sum)"),
                     ));
                 }
                 let distribution = args.distribution.unwrap_or(Distribution::Ggx);
@@ -417,14 +429,13 @@ impl Spec {
         match *self {
             Spec::SplitSum {
                 size,
-                samples,
                 g_model,
-                sampling,
+                estimate,
             } => Table {
                 width: size,
                 height: size,
                 channels: &["R", "G"],
-                data: split_sum::split_sum(size, samples, g_model, sampling, progress),
+                data: split_sum::split_sum(size, g_model, estimate, progress),
             },
             Spec::KullaConty {
                 size,
@@ -476,13 +487,13 @@ pub struct LutSummary {
     pub height: usize,
     /// What each stored channel holds, in order.
     pub channels: Vec<String>,
-    /// Samples per texel (none for `albedo`, which is quadrature).
+    /// Samples per texel (none for quadrature: `albedo` and split-sum's default method).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub samples: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub g_model: Option<GModel>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sampling: Option<Sampling>,
+    pub method: Option<Method>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub distribution: Option<Distribution>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -528,16 +539,19 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         message: format!("cannot encode the table as {}: {message}", format.key()),
     })?;
     write_output(&args.out, &bytes)?;
-    let (samples, g_model, sampling, distribution, blender_version, channels) = match spec {
+    let (samples, g_model, method, distribution, blender_version, channels) = match spec {
         Spec::SplitSum {
-            samples,
-            g_model,
-            sampling,
-            ..
+            g_model, estimate, ..
         } => (
-            Some(samples),
+            match estimate {
+                split_sum::Estimate::Classic { samples } => Some(samples),
+                split_sum::Estimate::Quadrature(_) => None,
+            },
             Some(g_model),
-            Some(sampling),
+            Some(match estimate {
+                split_sum::Estimate::Classic { .. } => Method::Classic,
+                split_sum::Estimate::Quadrature(_) => Method::Quadrature,
+            }),
             None,
             None,
             vec!["R: scale".to_string(), "G: bias".to_string()],
@@ -594,7 +608,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         channels,
         samples,
         g_model,
-        sampling,
+        method,
         distribution,
         blender_version,
         ior: matches!(spec, Spec::Coat { .. }).then(coat::ior),
