@@ -36,6 +36,8 @@ Examples:
   gloffuse generate --extension gloffuse.zip     an extension to install in Blender 4.2+
   gloffuse generate --blend lib/gloffuse.blend --mode roughness,view
                                                  a library .blend with the view groups too
+  gloffuse generate --blend lib/gloffuse.blend --mode layered
+                                                 the glossy-over-diffuse Gloffuse Layered groups
   gloffuse generate --into scene.blend           update the groups in your file, in place
   gloffuse generate --script gloffuse.py         a script for Blender's Text Editor";
 
