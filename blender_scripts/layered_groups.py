@@ -118,7 +118,7 @@ def build_layered_group(spec, params):
     layered = spec["layered"]
     tree = reuse_or_create_group(layered["shader_group"])
     ensure_interface(tree, layered_sockets())
-    nodes, links = tree.nodes, tree.links
+    nodes = tree.nodes
     group_in = nodes.new("NodeGroupInput")
     group_in.location = (0.0, 0.0)
     frame = new_frame(tree, "Coat frame",
@@ -134,30 +134,10 @@ def build_layered_group(spec, params):
     base = chain.math("SUBTRACT", "1 - A", 1.0, a, name="Base weight")
     base_color = chain.vector("SCALE", "Base Color × (1 - A)", group_in.outputs["Base Color"],
                               base, name="Base colour")
-    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1)
-    glossy = glossy_node(nodes, spec["distribution"])
-    glossy.name = "Glossy BSDF"
-    glossy.label = short_label("Coat: Glossy BSDF (%s)" % spec["distribution"])
-    glossy.width = NODE_WIDTH
-    glossy.location = (x, 200.0)
-    links.new(glossy_color, glossy.inputs["Color"])
-    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
-    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.name = "Diffuse BSDF"
-    diffuse.label = "Base: Diffuse BSDF"
-    diffuse.width = NODE_WIDTH
-    diffuse.location = (x, -ROW_STEP)
-    links.new(base_color, diffuse.inputs["Color"])
-    links.new(group_in.outputs["Normal"], diffuse.inputs["Normal"])
-    add = nodes.new("ShaderNodeAddShader")
-    add.name = "Coat + base"
-    add.location = (x + COLUMN_STEP, 0.0)
-    links.new(glossy.outputs[0], add.inputs[0])
-    links.new(diffuse.outputs[0], add.inputs[1])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
-    links.new(add.outputs[0], group_out.inputs["BSDF"])
+    glossy_plus_diffuse(tree, spec, group_in, glossy_color, base_color,  # view_groups.py
+                        FRAME_INSET + COLUMN_STEP * (chain.column + 1),
+                        ("Coat: Glossy BSDF (%s)" % spec["distribution"], "Base: Diffuse BSDF",
+                         "Coat + base"))
     description = description_text(spec, params, (
         "Glossy %s coat over a diffuse base: the coat reflects A(mu, r, IOR), the albedo of "
         "a dielectric microfacet coat with its lost energy given back (Kulla-Conty, as "

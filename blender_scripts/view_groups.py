@@ -141,6 +141,38 @@ def tinted_energy(chain, color, e_avg):
                         chain.vector("SCALE", "C E_avg", color, e_avg), den)
 
 
+def glossy_plus_diffuse(tree, spec, group_in, glossy_color, diffuse_color, x, labels):
+    """Glossy BSDF (the spec's distribution; the group's Roughness and Normal) of
+    colour glossy_color, plus a Diffuse BSDF of colour diffuse_color (the group's
+    Normal), into the group's BSDF output; nodes from column x on, labelled
+    (glossy, diffuse, add)."""
+    nodes, links = tree.nodes, tree.links
+    glossy_label, diffuse_label, add_label = labels
+    glossy = glossy_node(nodes, spec["distribution"])
+    glossy.name = "Glossy BSDF"
+    glossy.label = short_label(glossy_label)
+    glossy.width = NODE_WIDTH
+    glossy.location = (x, 200.0)
+    links.new(glossy_color, glossy.inputs["Color"])
+    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
+    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.name = "Diffuse BSDF"
+    diffuse.label = diffuse_label
+    diffuse.width = NODE_WIDTH
+    diffuse.location = (x, -ROW_STEP)
+    links.new(diffuse_color, diffuse.inputs["Color"])
+    links.new(group_in.outputs["Normal"], diffuse.inputs["Normal"])
+    add = nodes.new("ShaderNodeAddShader")
+    add.name = add_label
+    add.location = (x + COLUMN_STEP, 0.0)
+    links.new(glossy.outputs[0], add.inputs[0])
+    links.new(diffuse.outputs[0], add.inputs[1])
+    group_out = nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    links.new(add.outputs[0], group_out.inputs["BSDF"])
+
+
 def build_view_correction_group(spec, params):
     """Roughness, Color, Normal -> Color, Gain with Gain = 1 / E(mu, r)."""
     view = spec["view"]
@@ -246,28 +278,8 @@ def build_multiscatter_group(spec, params):
         mix.location = (x + COLUMN_STEP, -ROW_STEP)
         links.new(color, color_a)
         links.new(lost.outputs[0], color_b)
-    glossy = glossy_node(nodes, spec["distribution"])
-    glossy.name = "Glossy BSDF"
-    glossy.label = short_label("Glossy BSDF (%s)" % spec["distribution"])
-    glossy.width = NODE_WIDTH
-    glossy.location = (x + 2 * COLUMN_STEP, 200.0)
-    links.new(color, glossy.inputs["Color"])
-    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
-    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.name = "Diffuse BSDF"
-    diffuse.width = NODE_WIDTH
-    diffuse.location = (x + 2 * COLUMN_STEP, -ROW_STEP)
-    links.new(diffuse_color, diffuse.inputs["Color"])
-    links.new(group_in.outputs["Normal"], diffuse.inputs["Normal"])
-    add = nodes.new("ShaderNodeAddShader")
-    add.name = "Add"
-    add.location = (x + 3 * COLUMN_STEP, 0.0)
-    links.new(glossy.outputs[0], add.inputs[0])
-    links.new(diffuse.outputs[0], add.inputs[1])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (x + 4 * COLUMN_STEP, 0.0)
-    links.new(add.outputs[0], group_out.inputs["BSDF"])
+    glossy_plus_diffuse(tree, spec, group_in, color, diffuse_color, x + 2 * COLUMN_STEP,
+                        ("Glossy BSDF (%s)" % spec["distribution"], "Diffuse BSDF", "Add"))
     description = description_text(spec, params, (
         "Glossy BSDF (%s) plus a diffuse lobe of colour %s: the energy single scattering "
         "loses comes back, so an evenly lit white surface is 100 %% at every pixel without "
