@@ -271,10 +271,11 @@ fn parse_model(s: &str) -> Result<Model, String> {
 }
 
 fn parse_ior(s: &str) -> Result<f64, String> {
+    let max = gloffuse::measure::coat::IOR_MAX;
     match s.trim().parse::<f64>() {
-        Ok(n) if (1.0..=3.0).contains(&n) => Ok(n),
+        Ok(n) if (1.0..=max).contains(&n) => Ok(n),
         _ => Err(format!(
-            "'{s}' is not an index of refraction from 1 to 3 (e.g. 1.5, glass)"
+            "'{s}' is not an index of refraction from 1 to {max} (e.g. 1.5, glass)"
         )),
     }
 }

@@ -125,13 +125,26 @@ impl<'a> Coat<'a> {
         coat_albedo(e_f, e, self.f_avg, self.e_avg)
     }
 
-    /// What the hand-made glossy-over-diffuse material reflects at view cosine μ: a Mix
-    /// Shader whose factor is the smooth Fresnel `F(μ)` (Blender's Fresnel node) over a
-    /// white Glossy of this lobe and a Diffuse of reflectance `base`:
-    /// `F(μ) E(μ) + (1 − F(μ)) base`.
-    pub fn hand_mix_albedo(&self, mu: f64, base: f64) -> f64 {
-        let f = fresnel::dielectric(mu, self.eta);
-        f * self.integrator.directional_albedo(&self.glossy, mu) + (1.0 - f) * base
+    /// `2 ∫₀¹ A(μ) μ dμ`: the mean of A over an orthographic sphere.
+    pub fn average(&self) -> f64 {
+        self.integrator.hemispherical_average(|mu| self.albedo(mu))
+    }
+
+    /// The white lobe's `E_avg`.
+    pub fn e_avg(&self) -> f64 {
+        self.e_avg
+    }
+
+    /// The mean over an orthographic sphere of what the hand-made glossy-over-diffuse
+    /// material reflects, per channel of the base: a Mix Shader whose factor is the smooth
+    /// Fresnel `F(μ)` (Blender's Fresnel node) over a white Glossy of this lobe and a Diffuse
+    /// of reflectance `base`, `F(μ) E(μ) + (1 − F(μ)) base`. It is linear in the base, so
+    /// its mean is `2∫ F E μ dμ + base (1 − F_avg)`.
+    pub fn hand_mix_average(&self, base: [f64; 3]) -> [f64; 3] {
+        let glossy = self.integrator.hemispherical_average(|mu| {
+            fresnel::dielectric(mu, self.eta) * self.integrator.directional_albedo(&self.glossy, mu)
+        });
+        base.map(|c| glossy + c * (1.0 - self.f_avg))
     }
 }
 

@@ -45,6 +45,16 @@ pub fn reference_label(mode: Mode) -> &'static str {
     }
 }
 
+/// The index of every block of rows: each of `ior` (layered mode), or one block with no
+/// index when `ior` is empty.
+pub fn ior_slots(ior: &[f64]) -> Vec<Option<f64>> {
+    if ior.is_empty() {
+        vec![None]
+    } else {
+        ior.iter().copied().map(Some).collect()
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
     pub role: Role,
@@ -95,13 +105,8 @@ impl Plan {
         ior: &[f64],
         settings: RenderSettings,
     ) -> Self {
-        let iors: Vec<Option<f64>> = if ior.is_empty() {
-            vec![None]
-        } else {
-            ior.iter().copied().map(Some).collect()
-        };
         let mut cells = Vec::new();
-        for ior in iors {
+        for ior in ior_slots(ior) {
             let roles = distributions
                 .iter()
                 .flat_map(|&d| [Role::Uncorrected(d), Role::Corrected(d)])

@@ -3,13 +3,13 @@
 
 use serde::Serialize;
 
-use super::plan::Role;
+use super::plan::{Role, ior_slots};
 use super::render::{RenderInfo, Rendered};
 use super::stats::SphereStats;
 use crate::Error;
 use crate::fit::{Coefficients, ColorSpace, preset_for};
 use crate::generate::{ColorModel, Mode};
-use crate::measure::coat::Coat;
+use crate::measure::coat::{Coat, multiscatter_tint};
 use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Glossy, Roughness, fresnel};
 
 /// Rings with fewer fully covered pixels than this are too noisy to judge flatness by (at
@@ -162,12 +162,6 @@ pub struct Sweep<'a> {
     pub color_model: ColorModel,
 }
 
-/// Kulla and Conty's tint of the energy multiple bounces add, per channel:
-/// `Fms = C E_avg / (1 − C (1 − E_avg))` (Cycles' Multiscatter GGX uses the same).
-fn tinted_energy(color: [f64; 3], e_avg: f64) -> [f64; 3] {
-    color.map(|c| c * e_avg / (1.0 - c * (1.0 - e_avg)))
-}
-
 /// What a correction promises a surface whose (mean) directional albedo is `e`, of a
 /// distribution and roughness with hemispherical albedo `e_avg`: `C` (exact), or
 /// `C (E + Fms (1 − E))` (physical).
@@ -175,7 +169,8 @@ fn target(model: ColorModel, color: [f64; 3], e_avg: f64, e: f64) -> [f64; 3] {
     match model {
         ColorModel::Exact => color,
         ColorModel::Physical => {
-            let fms = tinted_energy(color, e_avg);
+            // Kulla and Conty's tint, as Cycles' Multiscatter GGX applies it per channel.
+            let fms = color.map(|c| multiscatter_tint(c, e_avg));
             [0, 1, 2].map(|c| color[c] * (e + fms[c] * (1.0 - e)))
         }
     }
@@ -192,6 +187,11 @@ fn relative(measured: [f64; 3], target: [f64; 3]) -> (f64, f64) {
 /// `a + C (1 − a)` per channel.
 fn layered_target(color: [f64; 3], a: f64) -> [f64; 3] {
     color.map(|c| a + c * (1.0 - a))
+}
+
+/// What a layered sphere of base colour `C` promises as a whole: `A_avg + C (1 − A_avg)`.
+fn layered_sphere_target(coat: &Coat, color: [f64; 3]) -> [f64; 3] {
+    layered_target(color, coat.average())
 }
 
 /// The mean of an albedo `f(μ)` over a view-cosine ring [lo, hi) of an orthographic sphere,
@@ -239,32 +239,28 @@ pub fn judge(
         plan.find(role, r, ior)
             .expect("the plan holds every role at every roughness and index")
     };
-    let iors: Vec<Option<f64>> = if ior.is_empty() {
-        vec![None]
-    } else {
-        ior.iter().copied().map(Some).collect()
-    };
+    let iors = ior_slots(ior);
     let mut rows = Vec::new();
     for &ior in &iors {
         for &d in distributions {
             let curve = &coefficients.distributions[&d].curve;
             for &r in roughness {
                 let glossy = Glossy::new(d, masking, Roughness::new(r)?);
-                let e_avg = integrator.average_albedo(&glossy);
+                let coat = ior.map(|n| Coat::new(&integrator, glossy, n));
+                let e_avg = match &coat {
+                    Some(coat) => coat.e_avg(),
+                    None => integrator.average_albedo(&glossy),
+                };
                 let cells = [
                     find(Role::Uncorrected(d), r, ior),
                     find(Role::Corrected(d), r, ior),
                 ];
                 let [uncorrected, corrected] = cells.map(|i| rendered.stats[i].clone());
-                let coat = ior.map(|n| Coat::new(&integrator, glossy, n));
                 // What the sphere promises as a whole and ring by ring (every pixel's target:
                 // shown in every mode, judged in the per-pixel modes).
                 let (target, ring_targets): ([f64; 3], Vec<[f64; 3]>) = match &coat {
                     Some(coat) => (
-                        layered_target(
-                            color,
-                            integrator.hemispherical_average(|mu| coat.albedo(mu)),
-                        ),
+                        layered_sphere_target(coat, color),
                         corrected
                             .rings
                             .iter()
@@ -300,12 +296,7 @@ pub fn judge(
                 };
                 let predicted_uncorrected = match &coat {
                     // The hand-made Mix Shader: F E + (1 − F) C, averaged over the sphere.
-                    Some(coat) => {
-                        let mix = color.map(|c| {
-                            integrator.hemispherical_average(|mu| coat.hand_mix_albedo(mu, c))
-                        });
-                        relative(mix, target).0
-                    }
+                    Some(coat) => relative(coat.hand_mix_average(color), target).0,
                     None => e_avg,
                 };
                 rows.push(Row {
@@ -342,13 +333,7 @@ pub fn judge(
             // Multiscatter GGX promises what a corrected GGX sphere does; Principled BSDF
             // what a layered GGX coat does.
             let promise = match ior {
-                Some(n) => {
-                    let coat = Coat::new(&integrator, ggx, n);
-                    layered_target(
-                        color,
-                        integrator.hemispherical_average(|mu| coat.albedo(mu)),
-                    )
-                }
+                Some(n) => layered_sphere_target(&Coat::new(&integrator, ggx, n), color),
                 None => {
                     let e_avg = integrator.average_albedo(&ggx);
                     target(color_model, color, e_avg, e_avg)
