@@ -4,7 +4,7 @@
 # A white world of strength 1, an orthographic camera looking down -Z at a grid
 # of white spheres (one cell per sphere, row 0 at the top of the image), each
 # sphere visible to camera rays only so that it sees nothing but the world.
-# One Cycles render of the whole grid is written as a single-layer, 32-bit
+# One Cycles or EEVEE render of the whole grid is written as a single-layer, 32-bit
 # float, ZIP-compressed OpenEXR (scene-linear RGBA, premultiplied by coverage
 # because the film is transparent). The "furnace" section of the parameter
 # document says what to render (furnace_params checks it).
@@ -26,6 +26,7 @@ import bpy
 import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
 
 FURNACE_PLAIN_DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY", "MULTI_GGX")
+FURNACE_ENGINES = ("cycles", "eevee")
 
 # Each sphere is the upper half (plus one ring) of a UV sphere with this many
 # segments and rings (counted on the full sphere). The sphere's mean converges
@@ -77,7 +78,8 @@ def furnace_sphere_spec(index, sphere):
     """Check one sphere entry and return a normalised copy. Shaders: "plain" (a
     Glossy BSDF), "group" (a gloffuse shader group, with an "ior" for the
     layered groups), "mix" (what artists build by hand: Mix Shader with a
-    Fresnel factor over Diffuse and Glossy) and "principled" (Principled BSDF)."""
+    Fresnel factor over Diffuse and Glossy), "principled" (Principled BSDF) and
+    "diffuse" (a Diffuse BSDF: how bright the engine's lighting itself is)."""
     where = "spheres[%d]" % index
     furnace_require(isinstance(sphere, dict), "%s must be an object" % where)
     roughness = furnace_number(sphere, "roughness", float, 0.0, 1.0)
@@ -98,10 +100,10 @@ def furnace_sphere_spec(index, sphere):
                         "%s.group must be a node group name" % where)
         spec["group"] = group
         return spec
-    if shader == "principled":
+    if shader in ("principled", "diffuse"):
         return spec
     raise FurnaceParamsError("furnace parameters: %s.shader must be \"plain\", \"group\", "
-                             "\"mix\" or \"principled\", got %r" % (where, shader))
+                             "\"mix\", \"principled\" or \"diffuse\", got %r" % (where, shader))
 
 
 def furnace_color(section):
@@ -121,7 +123,11 @@ def furnace_params(document):
     furnace_require(isinstance(output, str) and output != "", "\"output\" must be a file path")
     spheres = section.get("spheres")
     furnace_require(isinstance(spheres, list) and spheres, "\"spheres\" must be a non-empty list")
+    engine = section.get("engine", "cycles")
+    furnace_require(engine in FURNACE_ENGINES,
+                    "\"engine\" must be one of %s, got %r" % (", ".join(FURNACE_ENGINES), engine))
     return {
+        "engine": engine,
         "cell": furnace_number(section, "cell", int, 4),
         "columns": furnace_number(section, "columns", int, 1),
         "samples": furnace_number(section, "samples", int, 1),
@@ -194,6 +200,8 @@ def furnace_label(sphere):
         label = sphere["group"]
     elif sphere["shader"] == "principled":
         label = "Principled BSDF"
+    elif sphere["shader"] == "diffuse":
+        label = "Diffuse BSDF"
     else:
         label = "%s %s" % (sphere["shader"], sphere["distribution"])
     if "ior" in sphere:
@@ -236,6 +244,9 @@ def furnace_material(index, sphere, color):
         node = tree.nodes.new("ShaderNodeBsdfPrincipled")
         compat_principled_dielectric(node, sphere["ior"])  # noqa: F821 -- compat.py
         shader_output = node.outputs["BSDF"]
+    elif sphere["shader"] == "diffuse":
+        node = tree.nodes.new("ShaderNodeBsdfDiffuse")
+        shader_output = node.outputs["BSDF"]
     elif sphere["shader"] == "plain":
         node = tree.nodes.new("ShaderNodeBsdfGlossy")
         node.distribution = sphere["distribution"]
@@ -276,7 +287,6 @@ def furnace_camera(columns):
 
 def furnace_render_settings(scene, furnace, columns, rows):
     render = scene.render
-    render.engine = "CYCLES"
     render.resolution_x = columns * furnace["cell"]
     render.resolution_y = rows * furnace["cell"]
     render.resolution_percentage = 100
@@ -290,18 +300,12 @@ def furnace_render_settings(scene, furnace, columns, rows):
         render.threads = furnace["threads"]
     else:
         render.threads_mode = "AUTO"
-
-    cycles = scene.cycles
-    cycles.device = "CPU"
-    cycles.samples = furnace["samples"]
-    cycles.seed = furnace["seed"]
-    cycles.use_animated_seed = False
-    cycles.use_adaptive_sampling = False
-    compat_disable_time_limit(cycles)  # noqa: F821 -- compat.py
-    # Clamping would bias the estimate; 0 disables it.
-    cycles.sample_clamp_direct = 0.0
-    cycles.sample_clamp_indirect = 0.0
-    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
+    if furnace["engine"] == "eevee":
+        render.engine = compat_eevee_engine()  # noqa: F821 -- compat.py
+        compat_eevee_furnace(scene, scene.world, furnace["samples"])  # noqa: F821
+    else:
+        render.engine = "CYCLES"
+        furnace_cycles_settings(scene.cycles, scene, furnace)
 
     view = scene.view_settings
     scene.display_settings.display_device = "sRGB"
@@ -313,12 +317,27 @@ def furnace_render_settings(scene, furnace, columns, rows):
     compat_exr_settings(render.image_settings)  # noqa: F821 -- compat.py
 
 
+def furnace_cycles_settings(cycles, scene, furnace):
+    """An unbiased, noise-only Cycles render: fixed samples and seed, no
+    clamping, no denoising."""
+    cycles.device = "CPU"
+    cycles.samples = furnace["samples"]
+    cycles.seed = furnace["seed"]
+    cycles.use_animated_seed = False
+    cycles.use_adaptive_sampling = False
+    compat_disable_time_limit(cycles)  # noqa: F821 -- compat.py
+    # Clamping would bias the estimate; 0 disables it.
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
+
+
 def furnace_scene(furnace):
     """Build the furnace grid in the current (empty) scene and return it."""
     scene = bpy.context.scene
     columns, rows = furnace_grid(furnace)
+    scene.world = furnace_world()  # before the settings: EEVEE's are partly the world's
     furnace_render_settings(scene, furnace, columns, rows)
-    scene.world = furnace_world()
 
     camera = furnace_camera(columns)
     scene.collection.objects.link(camera)

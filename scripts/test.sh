@@ -3,6 +3,7 @@
 #   Blender 3.4 — Debian's `blender` package (a real binary)
 #   Blender 4.5 LTS and 5.0 — PyPI's `bpy` (Blender as a Python module, CPython 3.11)
 #   Chromium — Debian's `chromium`, to load and screenshot the HTML report
+#   Mesa's software OpenGL (`libegl1`, `libgl1-mesa-dri`) — EEVEE renders headless with it
 # Idempotent: a second run reuses what the first installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,10 +11,13 @@ cd "$(dirname "$0")/.."
 cache="${GLOFFUSE_TEST_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/gloffuse/test-blenders}"
 mkdir -p "$cache"
 
-# Debian's blender (3.4) and, for the report page's browser test, Debian's chromium.
+# Debian's blender (3.4), Mesa for EEVEE and, for the report page's browser test, chromium.
 missing=""
 command -v blender >/dev/null 2>&1 || missing="$missing blender"
 [ -x /usr/bin/chromium ] || missing="$missing chromium"
+for package in libegl1 libgl1-mesa-dri; do
+    dpkg -s "$package" >/dev/null 2>&1 || missing="$missing $package"
+done
 if [ -n "$missing" ]; then
     echo "== installing Debian's$missing"
     SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"

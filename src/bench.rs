@@ -7,7 +7,7 @@ use std::time::Instant;
 use crate::Error;
 use crate::blender::BlenderOptions;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{Distribution, Roughness};
+use crate::measure::{Distribution, Engine, Roughness};
 use crate::progress::{Progress, Quiet};
 use crate::verify::{Plan, RenderSettings, default_roughness, render};
 
@@ -42,7 +42,7 @@ pub struct BenchResult {
 pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, Error> {
     let blender = b.blender.find(progress)?;
     let groups = GenerateParams::new(
-        Curves::Presets,
+        Curves::Presets(&[Engine::Cycles]),
         &[blender.version.masking()],
         &[Mode::Roughness],
         ColorModel::Exact,

@@ -9,11 +9,11 @@ use crate::blender::{Blender, BlenderOptions};
 use crate::fit::coefficients::{INTEGRATOR_DEGREE, today};
 use crate::fit::{Coefficients, FitSpec, Point, Provenance, Source, Target, Weighting};
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{AlbedoIntegrator, Distribution, Glossy, Roughness};
+use crate::measure::{AlbedoIntegrator, Distribution, Engine, Roughness};
 use crate::output::check_destination;
 use crate::progress::Progress;
 use crate::verify::{
-    Plan, RenderSettings, Rendered, Role, VerifyOptions, VerifyReport, render, verify_with,
+    Judging, Plan, RenderSettings, Rendered, Role, VerifyOptions, VerifyReport, render, verify_with,
 };
 
 /// What `refresh` measures and where it writes the result.
@@ -23,7 +23,8 @@ pub struct RefreshOptions {
     pub out: PathBuf,
     /// Polynomial degree in r.
     pub degree: usize,
-    /// How the measurement is rendered (the verify run uses verify's own samples).
+    /// How (and in which engine) the measurement is rendered (the verify run uses verify's
+    /// own samples).
     pub render: RenderSettings,
     /// Verify the new coefficients afterwards.
     pub verify: bool,
@@ -32,17 +33,31 @@ pub struct RefreshOptions {
 
 impl Default for RefreshOptions {
     fn default() -> Self {
+        RefreshOptions::for_engine(Engine::Cycles)
+    }
+}
+
+impl RefreshOptions {
+    pub fn for_engine(engine: Engine) -> Self {
         RefreshOptions {
             out: PathBuf::from("coefficients.json"),
             degree: INTEGRATOR_DEGREE,
-            // 64 spp: twice verify's, so the fit's own noise stays below the check's.
             render: RenderSettings {
-                samples: 64,
-                ..RenderSettings::default()
+                samples: measure_samples(engine),
+                ..RenderSettings::for_engine(engine)
             },
             verify: true,
             blender: BlenderOptions::default(),
         }
+    }
+}
+
+/// Samples per pixel of the measurement: Cycles 64, twice verify's, so the fit's own noise
+/// stays below the check's; EEVEE's furnace has no noise (verify's 1).
+pub fn measure_samples(engine: Engine) -> u32 {
+    match engine {
+        Engine::Cycles => 64,
+        Engine::Eevee => crate::verify::plan::default_samples(engine),
     }
 }
 
@@ -53,6 +68,7 @@ pub const DISAGREEMENT: f64 = 0.005;
 pub struct Measurement {
     pub distribution: Distribution,
     pub roughness: f64,
+    /// The sphere's mean, relative to the white Diffuse sphere in EEVEE.
     pub measured: f64,
     pub standard_error: f64,
     pub predicted: f64,
@@ -61,6 +77,10 @@ pub struct Measurement {
 #[derive(Debug, Serialize)]
 pub struct Refreshed {
     pub blender_version: String,
+    pub engine: Engine,
+    /// EEVEE: the white Diffuse sphere's mean, which every measurement is divided by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lighting: Option<f64>,
     pub out: String,
     pub measurements: Vec<Measurement>,
     pub warnings: Vec<String>,
@@ -77,12 +97,13 @@ fn grid() -> Vec<f64> {
 pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed, Error> {
     // The output is checked before Blender is looked for: bad input fails fast.
     check_destination(&a.out)?;
+    let engine = a.render.engine;
     let blender = a.blender.find(progress)?;
     let rs = grid();
     let plan = Plan::measure(&Distribution::ALL, &rs, a.render);
     // Plain spheres need no groups; the furnace script still builds them from a preset.
     let groups = GenerateParams::new(
-        Curves::Presets,
+        Curves::Presets(&[Engine::Cycles]),
         &[blender.version.masking()],
         &[Mode::Roughness],
         ColorModel::Exact,
@@ -99,6 +120,10 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
 
     let integrator = AlbedoIntegrator::default();
     let masking = blender.version.masking();
+    // EEVEE Next's world lighting is 0.8 % dark for every material: the curve corrects the
+    // BSDF's loss, measured against a white Diffuse sphere in the same image.
+    let lighting = plan.lighting().map(|cell| stats[cell].mean);
+    let scale = 1.0 / lighting.unwrap_or(1.0);
     let mut measurements = Vec::new();
     let mut warnings = Vec::new();
     for (cell, s) in plan.cells.iter().zip(&stats) {
@@ -106,23 +131,24 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
             continue;
         };
         let predicted =
-            integrator.average_albedo(&Glossy::new(d, masking, Roughness::new(cell.roughness)?));
-        if (s.mean / predicted - 1.0).abs() > DISAGREEMENT {
+            integrator.average_albedo(&engine.glossy(d, masking, Roughness::new(cell.roughness)?));
+        let measured = s.mean * scale;
+        if (measured / predicted - 1.0).abs() > DISAGREEMENT {
             warnings.push(format!(
-                "{} r = {}: Blender {} renders {:.2} %, the integrator predicts {:.2} % ({:+.2} %)",
+                "{} r = {}: {engine} in Blender {} renders {:.2} %, the integrator predicts {:.2} % ({:+.2} %)",
                 d.label(),
                 cell.roughness,
                 blender.version_string,
-                100.0 * s.mean,
+                100.0 * measured,
                 100.0 * predicted,
-                100.0 * (s.mean / predicted - 1.0)
+                100.0 * (measured / predicted - 1.0)
             ));
         }
         measurements.push(Measurement {
             distribution: d,
             roughness: cell.roughness,
-            measured: s.mean,
-            standard_error: s.standard_error,
+            measured,
+            standard_error: s.standard_error * scale,
             predicted,
         });
     }
@@ -131,7 +157,9 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
         degree: a.degree,
         weighting: Weighting::Relative,
         target: Target::Mean,
-        masking,
+        // The masking of the BSDF the engine renders.
+        masking: engine.model(Distribution::Ggx, masking).1,
+        engine,
         provenance: Provenance {
             source: Source::Blender,
             blender_version: Some(blender.version_string.clone()),
@@ -139,7 +167,13 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
             resolution: Some(a.render.cell),
             points: 0,
             date: Some(today()),
-            note: Some("mean of rendered white furnace spheres (Σ RGB / Σ alpha)".into()),
+            note: Some(match engine {
+                Engine::Cycles => "mean of rendered white furnace spheres (Σ RGB / Σ alpha)".into(),
+                Engine::Eevee => format!(
+                    "mean of white furnace spheres rendered in EEVEE (Σ RGB / Σ alpha), divided by a white Diffuse sphere's ({:.4})",
+                    lighting.unwrap_or(1.0)
+                ),
+            }),
         },
     };
     let points = Distribution::ALL.map(|d| {
@@ -154,9 +188,9 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
         (d, points)
     });
     let coefficients = Coefficients::fit(
-        format!("measured in Blender {}", blender.version_string),
+        format!("measured in {engine}, Blender {}", blender.version_string),
         format!(
-            "Mean brightness of white glossy furnace spheres rendered in Blender {} ({} spp, {} px), fitted by gloffuse refresh; gain = 100 / f(r).",
+            "Mean brightness of white glossy furnace spheres rendered in {engine}, Blender {} ({} spp, {} px), fitted by gloffuse refresh; gain = 100 / f(r).",
             blender.version_string, a.render.samples, a.render.cell
         ),
         &spec,
@@ -171,6 +205,8 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
     };
     Ok(Refreshed {
         blender_version: blender.version_string.clone(),
+        engine,
+        lighting,
         out: a.out.display().to_string(),
         measurements,
         warnings,
@@ -186,13 +222,15 @@ fn verify_new(
     a: &RefreshOptions,
     progress: &dyn Progress,
 ) -> Result<VerifyReport, Error> {
+    let engine = a.render.engine;
     let v = VerifyOptions {
         coefficients: Some(a.out.display().to_string()),
         render: RenderSettings {
             cell: a.render.cell,
             seed: 1,
-            ..RenderSettings::default()
+            ..RenderSettings::for_engine(engine)
         },
+        judging: Judging::for_engine(engine),
         blender: a.blender.clone(),
         ..VerifyOptions::default()
     };

@@ -7,6 +7,7 @@ mod common;
 
 use gloffuse::fit::Coefficients;
 use gloffuse::generate::{correction_group_name, shader_group_name};
+use gloffuse::measure::Engine;
 use serde_json::{Value, json};
 
 const PROBES: [f64; 6] = [0.0, 0.2, 0.5, 0.75, 1.0, 1.5];
@@ -18,8 +19,8 @@ fn expectations(preset: &str) -> Value {
         .iter()
         .map(|(&d, e)| {
             json!({
-                "correction_group": correction_group_name(d),
-                "shader_group": shader_group_name(d),
+                "correction_group": correction_group_name(Engine::Cycles, d),
+                "shader_group": shader_group_name(Engine::Cycles, d),
                 "distribution": d.blender_enum(),
                 // r = 1.5 probes the clamp: Blender must treat it as 1.
                 "probe": PROBES.iter().map(|&r| json!([r, e.curve.gain(r.min(1.0))])).collect::<Vec<_>>(),

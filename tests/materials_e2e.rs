@@ -61,7 +61,7 @@ fn render(
 ) -> (BlenderVersion, std::collections::BTreeMap<String, Rgba>) {
     let blender = probe(blender).unwrap();
     let generate = GenerateParams::new(
-        Curves::Presets,
+        Curves::Presets(&[gloffuse::measure::Engine::Cycles]),
         &[blender.version.masking()],
         &[Mode::View, Mode::Multiscatter],
         color_model,

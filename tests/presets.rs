@@ -4,7 +4,7 @@
 use gloffuse::fit::Weighting;
 use gloffuse::fit::{Coefficients, Target};
 use gloffuse::measure::BlenderVersion;
-use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
+use gloffuse::measure::{AlbedoIntegrator, Distribution, Engine, Glossy, Masking, Roughness};
 
 #[test]
 fn seed_preset_holds_the_hand_made_cubics() {
@@ -19,17 +19,25 @@ fn seed_preset_holds_the_hand_made_cubics() {
 #[test]
 fn linear_presets_are_within_a_tenth_of_a_percent() {
     let q = AlbedoIntegrator::default();
-    for (name, masking) in [
-        ("blender-3", Masking::Separable),
-        ("blender-4", Masking::HeightCorrelated),
+    // EEVEE renders every distribution as GGX with separable masking: its preset must hold
+    // that BSDF's E_avg, whatever the distribution's name.
+    for (name, masking, engine) in [
+        ("blender-3", Masking::Separable, Engine::Cycles),
+        ("blender-4", Masking::HeightCorrelated, Engine::Cycles),
+        ("eevee", Masking::Separable, Engine::Eevee),
     ] {
         let c = Coefficients::load(name).unwrap();
         for d in Distribution::ALL {
             let e = &c.distributions[&d];
-            assert_eq!(e.masking, masking);
+            assert_eq!((e.masking, e.engine), (masking, engine));
+            let model = match engine {
+                Engine::Cycles => d,
+                Engine::Eevee => Distribution::Ggx,
+            };
             for i in 0..=300 {
                 let r = i as f64 / 300.0;
-                let avg = q.average_albedo(&Glossy::new(d, masking, Roughness::new(r).unwrap()));
+                let avg =
+                    q.average_albedo(&Glossy::new(model, masking, Roughness::new(r).unwrap()));
                 let err = (e.curve.gain(r) * avg - 1.0).abs();
                 assert!(err < 1e-3, "{name} {d} r={r}: gain error {err}");
             }
@@ -39,11 +47,16 @@ fn linear_presets_are_within_a_tenth_of_a_percent() {
 
 #[test]
 fn shipped_presets_match_a_fresh_fit() {
-    for (name, version) in [("blender-3", "3.4"), ("blender-4", "4.5")] {
+    for (name, engine, version) in [
+        ("blender-3", Engine::Cycles, "3.4"),
+        ("blender-4", Engine::Cycles, "4.5"),
+        ("eevee", Engine::Eevee, "4.5"),
+    ] {
         let shipped = Coefficients::load(name).unwrap();
         let v: BlenderVersion = version.parse().unwrap();
         let fresh =
-            Coefficients::from_integrator(v, 6, Target::Mean, Weighting::Relative, None).unwrap();
+            Coefficients::from_integrator(engine, v, 6, Target::Mean, Weighting::Relative, None)
+                .unwrap();
         for d in Distribution::ALL {
             let (a, b) = (
                 &shipped.distributions[&d].curve,
@@ -63,6 +76,7 @@ fn shipped_presets_match_a_fresh_fit() {
 fn coefficient_files_are_byte_identical_for_equal_inputs() {
     let v: BlenderVersion = "4.5".parse().unwrap();
     let a = Coefficients::from_integrator(
+        Engine::Cycles,
         v,
         6,
         Target::Mean,
@@ -71,6 +85,7 @@ fn coefficient_files_are_byte_identical_for_equal_inputs() {
     )
     .unwrap();
     let b = Coefficients::from_integrator(
+        Engine::Cycles,
         v,
         6,
         Target::Mean,

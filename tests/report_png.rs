@@ -111,6 +111,7 @@ fn white_row(
         distribution,
         roughness,
         ior: None,
+        cycles_uncorrected: None,
         cells: [0, 0],
         target: [1.0; 3],
         uncorrected_brightness: uncorrected.mean,
@@ -173,6 +174,9 @@ fn small_report(img: &Rgba) -> VerifyReport {
         .map(|c| reference_sphere(roughness[c], stats(6 + c)))
         .collect();
     VerifyReport {
+        engine: gloffuse::measure::Engine::Cycles,
+        groups_engine: gloffuse::measure::Engine::Cycles,
+        lighting: None,
         mode: gloffuse::generate::Mode::Roughness,
         color: [1.0; 3],
         color_model: gloffuse::generate::ColorModel::Exact,
@@ -431,6 +435,9 @@ fn full_sweep_sheet_and_plot() {
         .map(|(c, &r)| reference_sphere(r, stats(6 * columns + c)))
         .collect();
     let report = VerifyReport {
+        engine: gloffuse::measure::Engine::Cycles,
+        groups_engine: gloffuse::measure::Engine::Cycles,
+        lighting: None,
         mode: gloffuse::generate::Mode::Roughness,
         color: [1.0; 3],
         color_model: gloffuse::generate::ColorModel::Exact,

@@ -13,8 +13,9 @@ use gloffuse::fit::{Point, Target, Weighting};
 use gloffuse::generate::{ColorModel, GenerateOptions, Mode};
 use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Method};
 use gloffuse::measure::brdf::{Model, ModelParams};
-use gloffuse::measure::{BlenderVersion, Distribution, Roughness};
+use gloffuse::measure::{BlenderVersion, Distribution, Engine, Roughness};
 use gloffuse::refresh::RefreshOptions;
+use gloffuse::verify::plan::default_samples;
 use gloffuse::verify::{Judging, LAYERED_IOR, RenderSettings, VerifyOptions, layered_roughness};
 
 const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
@@ -161,6 +162,17 @@ const MODES: &[Choice<Mode>] = &[
     choice(
         Mode::Layered,
         "a dielectric glossy coat (IOR) over a diffuse base: a white base reflects 100 % at every pixel",
+    ),
+];
+
+const ENGINES: &[Choice<Engine>] = &[
+    choice(
+        Engine::Cycles,
+        "Cycles: each distribution as its Glossy node evaluates it",
+    ),
+    choice(
+        Engine::Eevee,
+        "EEVEE (Legacy in 3.x, Next in 4.2+): every distribution renders as its split-sum GGX",
     ),
 ];
 
@@ -438,6 +450,11 @@ pub struct FitArgs {
     #[arg(long, default_value_t = BlenderVersion::DEFAULT, value_parser = parse_version)]
     pub blender_version: BlenderVersion,
 
+    /// The engine whose Glossy the curves correct: with --from integrator, eevee models what
+    /// EEVEE renders (every distribution as GGX with separable masking; the eevee preset).
+    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = Engine::Cycles.key())]
+    pub engine: Engine,
+
     /// Write a coefficients file (written atomically: never half-written).
     #[arg(long, value_name = "FILE.json")]
     pub out: Option<PathBuf>,
@@ -520,6 +537,13 @@ pub struct GenerateArgs {
     #[arg(long, value_parser = one_of(MODES, Mode::key), value_delimiter = ',', default_value = Mode::Roughness.key())]
     pub mode: Vec<Mode>,
 
+    /// The engines to build groups for, comma-separated: cycles builds `Gloffuse (…)` and the
+    /// rest, eevee builds `Gloffuse EEVEE (…)` and the rest, calibrated on what EEVEE renders
+    /// (every distribution as GGX); cycles,eevee puts both sets into one library [default:
+    /// cycles, or the engine the --coefficients were fitted for].
+    #[arg(long, value_parser = one_of(ENGINES, Engine::key), value_delimiter = ',')]
+    pub engine: Vec<Engine>,
+
     /// What a coloured correction keeps: exact (the surface's albedo is Color) or physical
     /// (multiple bounces tint and darken a coloured rough surface, as in Multiscatter GGX).
     #[arg(long, value_parser = one_of(COLOR_MODELS, ColorModel::key), default_value = GenerateOptions::default().color_model.key())]
@@ -542,6 +566,7 @@ impl GenerateArgs {
             into: self.into.clone(),
             extension: self.extension.clone(),
             modes: self.mode.clone(),
+            engines: self.engine.clone(),
             color_model: self.color_model,
             blender: self.blender.options(false),
         }
@@ -550,10 +575,17 @@ impl GenerateArgs {
 
 #[derive(Args, Debug)]
 pub struct VerifyArgs {
-    /// A preset (seed, blender-3, blender-4) or a coefficients file [default: the preset of
-    /// the Blender used].
+    /// A preset (seed, blender-3, blender-4, eevee) or a coefficients file [default: the
+    /// preset of the engine and Blender used]. An EEVEE sweep with blender-4 shows what the
+    /// Cycles groups do in EEVEE.
     #[arg(long, value_name = "PRESET|FILE")]
     pub coefficients: Option<String>,
+
+    /// The engine to render in: cycles, or eevee (Legacy in 3.x, Next in 4.2+; rendered
+    /// headless with the settings of docs/EEVEE.md, a white Diffuse sphere showing how bright
+    /// its lighting is, and each sphere shown next to what Cycles renders).
+    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = Engine::Cycles.key())]
+    pub engine: Engine,
 
     /// Distributions to check, comma-separated [default: all in the coefficients].
     #[arg(long, short = 'd', value_delimiter = ',', value_parser = parse_distribution)]
@@ -569,17 +601,18 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "N,...", value_delimiter = ',', value_parser = parse_ior)]
     pub ior: Vec<f64>,
 
-    /// Cycles samples per pixel (32 keeps each sphere's standard error ≤ 0.2 %).
-    #[arg(long, default_value_t = verify_defaults().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
-    pub spp: u32,
+    /// Samples per pixel [default: Cycles 32, which keeps each sphere's standard error
+    /// ≤ 0.2 %; EEVEE 1, its furnace has no noise].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: Option<u32>,
 
     /// Pixels across each sphere's cell.
     #[arg(long, default_value_t = verify_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub resolution: u32,
 
-    /// Allowed |mean − 100 %| of a corrected sphere, in percent.
-    #[arg(long, default_value_t = verify_defaults().judging.tolerance_percent, value_parser = parse_tolerance)]
-    pub tolerance: f64,
+    /// Allowed |mean − 100 %| of a corrected sphere, in percent [default: Cycles 1, EEVEE 2].
+    #[arg(long, value_parser = parse_tolerance)]
+    pub tolerance: Option<f64>,
 
     /// Cycles' random seed (another seed gives the same means with fresh noise).
     #[arg(long, default_value_t = verify_defaults().render.seed)]
@@ -601,9 +634,10 @@ pub struct VerifyArgs {
     #[arg(long, value_parser = one_of(COLOR_MODELS, ColorModel::key), default_value = verify_defaults().color_model.key())]
     pub color_model: ColorModel,
 
-    /// In the view modes: allowed |mean − 100 %| of every view-cosine ring, in percent.
-    #[arg(long, default_value_t = verify_defaults().judging.ring_tolerance_percent, value_parser = parse_tolerance)]
-    pub ring_tolerance: f64,
+    /// In the view modes: allowed |mean − 100 %| of every view-cosine ring, in percent
+    /// [default: Cycles 1.5, EEVEE 2].
+    #[arg(long, value_parser = parse_tolerance)]
+    pub ring_tolerance: Option<f64>,
 
     /// Also write report.html (a page with every sphere, failures first), report.json, the
     /// rendered sweep.exr, contact-sheet.png, brightness.png and deviation.png into this
@@ -640,16 +674,21 @@ impl VerifyArgs {
             },
             render: RenderSettings {
                 cell: self.resolution,
-                samples: self.spp,
+                samples: self.spp.unwrap_or(default_samples(self.engine)),
                 seed: self.seed,
-                ..RenderSettings::default()
+                ..RenderSettings::for_engine(self.engine)
             },
             mode: self.mode,
             color: self.color,
             color_model: self.color_model,
-            judging: Judging {
-                tolerance_percent: self.tolerance,
-                ring_tolerance_percent: self.ring_tolerance,
+            judging: {
+                let defaults = Judging::for_engine(self.engine);
+                Judging {
+                    tolerance_percent: self.tolerance.unwrap_or(defaults.tolerance_percent),
+                    ring_tolerance_percent: self
+                        .ring_tolerance
+                        .unwrap_or(defaults.ring_tolerance_percent),
+                }
             },
             blender: self.blender.options(self.json),
         }
@@ -666,9 +705,14 @@ pub struct RefreshArgs {
     #[arg(long, default_value_t = refresh_defaults().degree as u64, value_parser = clap::value_parser!(u64).range(2..=8))]
     pub degree: u64,
 
-    /// Cycles samples per pixel for the measurement.
-    #[arg(long, default_value_t = refresh_defaults().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
-    pub spp: u32,
+    /// The engine to measure: cycles, or eevee (the file then corrects EEVEE's Glossy, each
+    /// sphere divided by a white Diffuse one: EEVEE Next's lighting is 0.8 % dark).
+    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = Engine::Cycles.key())]
+    pub engine: Engine,
+
+    /// Samples per pixel for the measurement [default: Cycles 64, EEVEE 1].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    pub spp: Option<u32>,
 
     /// Pixels across each sphere's cell.
     #[arg(long, default_value_t = refresh_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
@@ -688,13 +732,13 @@ pub struct RefreshArgs {
 
 impl RefreshArgs {
     pub fn options(&self) -> RefreshOptions {
-        let defaults = RefreshOptions::default();
+        let defaults = RefreshOptions::for_engine(self.engine);
         RefreshOptions {
             out: self.out.clone(),
             degree: self.degree as usize,
             render: RenderSettings {
                 cell: self.resolution,
-                samples: self.spp,
+                samples: self.spp.unwrap_or(defaults.render.samples),
                 ..defaults.render
             },
             verify: !self.no_verify,

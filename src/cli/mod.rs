@@ -348,6 +348,7 @@ fn fit(f: &FitArgs, out: &mut dyn Write) -> Result<Outcome> {
             .into());
         }
         Coefficients::from_integrator(
+            f.engine,
             f.blender_version,
             f.degree.unwrap_or(INTEGRATOR_DEGREE),
             f.target,
@@ -376,6 +377,7 @@ fn fit(f: &FitArgs, out: &mut dyn Write) -> Result<Outcome> {
             f.degree.unwrap_or(POINTS_DEGREE),
             f.weighting,
             f.target,
+            f.engine,
             f.blender_version,
         )?
     };

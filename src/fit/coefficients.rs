@@ -8,7 +8,7 @@ use std::path::Path;
 use super::curve::{Curve, MAX_DEGREE, Point, Residuals, Variable, Weighting, fit_polynomial};
 use crate::Error;
 use crate::measure::{
-    AlbedoIntegrator, BlenderVersion, Distribution, Masking, Quadrature, Roughness,
+    AlbedoIntegrator, BlenderVersion, Distribution, Engine, Masking, Quadrature, Roughness,
 };
 use crate::output::write_output;
 use crate::progress::Quiet;
@@ -17,7 +17,7 @@ pub const FORMAT: &str = "gloffuse-coefficients";
 pub const FORMAT_VERSION: u32 = 1;
 
 /// Built-in presets: name, file contents, one-line summary.
-pub const PRESETS: [(&str, &str, &str); 3] = [
+pub const PRESETS: [(&str, &str, &str); 4] = [
     (
         "seed",
         include_str!("../../presets/seed.json"),
@@ -33,11 +33,20 @@ pub const PRESETS: [(&str, &str, &str); 3] = [
         include_str!("../../presets/blender-4.json"),
         "linear-space fits to E_avg for Blender 3.5 and later (height-correlated masking)",
     ),
+    (
+        "eevee",
+        include_str!("../../presets/eevee.json"),
+        "linear-space fits to E_avg for EEVEE (every distribution renders as its split-sum GGX)",
+    ),
 ];
 
-/// The preset fitted for `version`'s masking family: `blender-3` or `blender-4`.
-pub fn preset_for(version: BlenderVersion) -> &'static str {
-    preset_for_masking(version.masking())
+/// The preset fitted for what `engine` renders in `version`: `blender-3` or `blender-4`
+/// (Cycles, by masking family) or `eevee`.
+pub fn preset_for(engine: Engine, version: BlenderVersion) -> &'static str {
+    match engine {
+        Engine::Cycles => preset_for_masking(version.masking()),
+        Engine::Eevee => "eevee",
+    }
 }
 
 /// The preset fitted for a masking family.
@@ -130,6 +139,9 @@ pub struct Entry {
     pub target: Target,
     pub color_space: ColorSpace,
     pub masking: Masking,
+    /// The engine whose Glossy the curve corrects (absent in files: Cycles).
+    #[serde(default, skip_serializing_if = "Engine::is_cycles")]
+    pub engine: Engine,
     pub weighting: Weighting,
     pub residuals: Residuals,
     pub provenance: Provenance,
@@ -208,6 +220,14 @@ impl Coefficients {
         if self.distributions.is_empty() {
             return Err("holds no distributions".into());
         }
+        let engine = self.engine();
+        if let Some((d, e)) = self.distributions.iter().find(|(_, e)| e.engine != engine) {
+            return Err(format!(
+                "{d}: \"engine\" is \"{}\", but the other curves are for \"{}\" (a file holds one engine's curves)",
+                e.engine.key(),
+                engine.key()
+            ));
+        }
         for (d, e) in &self.distributions {
             let c = &e.curve;
             let all = c.numerator.iter().chain(&c.denominator);
@@ -265,6 +285,14 @@ impl Coefficients {
         Ok(())
     }
 
+    /// The engine every curve corrects (a file holds one engine's curves).
+    pub fn engine(&self) -> Engine {
+        self.distributions
+            .values()
+            .next()
+            .map_or(Engine::Cycles, |e| e.engine)
+    }
+
     pub fn to_json(&self) -> String {
         let mut s = serde_json::to_string_pretty(self).expect("coefficients serialise");
         s.push('\n');
@@ -279,13 +307,14 @@ impl Coefficients {
         write_output(path, text.as_bytes())
     }
 
-    /// A preset or file by name, or else the preset for `version`'s masking family;
-    /// returns the coefficients and the name they were loaded by.
+    /// A preset or file by name, or else the preset for what `engine` renders in
+    /// `version`; returns the coefficients and the name they were loaded by.
     pub fn load_or_preset(
         name: Option<&str>,
+        engine: Engine,
         version: BlenderVersion,
     ) -> Result<(Self, String), Error> {
-        let name = name.unwrap_or_else(|| preset_for(version));
+        let name = name.unwrap_or_else(|| preset_for(engine, version));
         Ok((Self::load(name)?, name.to_string()))
     }
 
@@ -308,6 +337,7 @@ impl Coefficients {
                     target: spec.target,
                     color_space: ColorSpace::Linear,
                     masking: spec.masking,
+                    engine: spec.engine,
                     weighting: spec.weighting,
                     residuals: fit.residuals,
                     provenance: Provenance {
@@ -326,16 +356,16 @@ impl Coefficients {
         })
     }
 
-    /// Measures E_avg (or E(1, r)) with the integrator for `version`'s masking on a
-    /// 201-point roughness grid and fits every distribution.
+    /// Measures E_avg (or E(1, r)) with the integrator for what `engine` renders in
+    /// `version` on a 201-point roughness grid and fits every distribution.
     pub fn from_integrator(
+        engine: Engine,
         version: BlenderVersion,
         degree: usize,
         target: Target,
         weighting: Weighting,
         date: Option<String>,
     ) -> Result<Self, Error> {
-        let masking = version.masking();
         let quadrature = Quadrature::default();
         let integrator = AlbedoIntegrator::new(quadrature);
         let rs = Roughness::grid(INTEGRATOR_POINTS);
@@ -343,14 +373,17 @@ impl Coefficients {
             Target::Mean => &[],
             Target::Center => &[1.0],
         };
+        // The masking of the curve's model (every distribution's, for one engine).
+        let (_, masking) = engine.model(Distribution::Ggx, version.masking());
         let spec = FitSpec {
             degree,
             weighting,
             target,
             masking,
+            engine,
             provenance: Provenance {
                 source: Source::Integrator,
-                blender_version: Some(version.to_string()),
+                blender_version: engine.is_cycles().then(|| version.to_string()),
                 samples: Some(format!(
                     "Gauss-Legendre quadrature {}x{} per E(mu), {} mu nodes",
                     quadrature.theta, quadrature.phi, quadrature.mu
@@ -362,7 +395,8 @@ impl Coefficients {
             },
         };
         let points = Distribution::ALL.map(|d| {
-            let grid = integrator.grid(d, masking, &rs, mus, &Quiet);
+            let (model, masking) = engine.model(d, version.masking());
+            let grid = integrator.grid(model, masking, &rs, mus, &Quiet);
             let values = match target {
                 Target::Mean => grid.e_avg,
                 Target::Center => grid.e,
@@ -377,16 +411,21 @@ impl Coefficients {
                 .collect();
             (d, points)
         });
-        Self::fit(
-            preset_for(version).into(),
-            format!(
-                "Linear-space brightness of a white glossy furnace sphere ({}) from gloffuse's integrator, {} masking (Blender {version}); gain = 100 / f(r).",
-                match target {
-                    Target::Mean => "mean, E_avg",
-                    Target::Center => "centre, E(1, r)",
-                },
-                masking
+        let target_text = match target {
+            Target::Mean => "mean, E_avg",
+            Target::Center => "centre, E(1, r)",
+        };
+        let description = match engine {
+            Engine::Cycles => format!(
+                "Linear-space brightness of a white glossy furnace sphere ({target_text}) from gloffuse's integrator, {masking} masking (Blender {version}); gain = 100 / f(r)."
             ),
+            Engine::Eevee => format!(
+                "Linear-space brightness of a white glossy furnace sphere in EEVEE ({target_text}) from gloffuse's integrator: EEVEE renders every distribution as GGX with separable masking (its split-sum table); gain = 100 / f(r)."
+            ),
+        };
+        Self::fit(
+            preset_for(engine, version).into(),
+            description,
             &spec,
             points,
         )
@@ -409,6 +448,8 @@ pub struct FitSpec {
     pub target: Target,
     /// The masking family the points were measured with.
     pub masking: Masking,
+    /// The engine whose Glossy the points were measured in.
+    pub engine: Engine,
     /// Where the points came from (`points` is filled in per distribution).
     pub provenance: Provenance,
 }

@@ -10,7 +10,7 @@ pub use coefficients::{
 pub use curve::{Curve, Fit, Point, Residuals, Variable, Weighting, fit_polynomial};
 
 use crate::Error;
-use crate::measure::{BlenderVersion, Distribution};
+use crate::measure::{BlenderVersion, Distribution, Engine};
 
 /// The degree of a fit through hand points unless one is given: the seed's cubic.
 pub const POINTS_DEGREE: usize = 3;
@@ -23,13 +23,15 @@ pub fn fit_points(
     degree: usize,
     weighting: Weighting,
     target: Target,
+    engine: Engine,
     version: BlenderVersion,
 ) -> Result<Coefficients, Error> {
     let spec = FitSpec {
         degree,
         weighting,
         target,
-        masking: version.masking(),
+        masking: engine.model(distribution, version.masking()).1,
+        engine,
         provenance: Provenance {
             source: Source::Points,
             blender_version: None,

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 use crate::Error;
 use crate::blender::{BlenderOptions, Run, command_line, run_script};
 use crate::fit::{Coefficients, preset_for};
-use crate::measure::{BlenderVersion, Masking};
+use crate::measure::{BlenderVersion, Engine, Masking};
 use crate::output::{Destination, check_destination, write_output};
 use crate::progress::Progress;
 use blend::{incomplete_blend, starts_like_blend, temp_beside};
@@ -40,6 +40,8 @@ pub struct GenerateOptions {
     pub extension: Option<PathBuf>,
     /// Which groups to build besides the roughness-only pair.
     pub modes: Vec<Mode>,
+    /// The engines to build groups for (empty: Cycles, or the engine of `coefficients`).
+    pub engines: Vec<Engine>,
     pub color_model: ColorModel,
     pub blender: BlenderOptions,
 }
@@ -53,6 +55,7 @@ impl Default for GenerateOptions {
             into: None,
             extension: None,
             modes: vec![Mode::Roughness],
+            engines: Vec::new(),
             color_model: ColorModel::Exact,
             blender: BlenderOptions::default(),
         }
@@ -133,6 +136,35 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
     Ok(())
 }
 
+/// The engines to build groups for: as asked, else Cycles, or the engine the pinned
+/// coefficients were fitted for (which must be the only one asked for).
+fn engines_of(
+    g: &GenerateOptions,
+    pinned: Option<(&Coefficients, &str)>,
+) -> Result<Vec<Engine>, Error> {
+    let Some((coefficients, name)) = pinned else {
+        return Ok(if g.engines.is_empty() {
+            vec![Engine::Cycles]
+        } else {
+            g.engines.clone()
+        });
+    };
+    let engine = coefficients.engine();
+    if g.engines.is_empty() || g.engines == [engine] {
+        return Ok(vec![engine]);
+    }
+    let asked: Vec<&str> = g.engines.iter().map(|e| e.key()).collect();
+    Err(Error::input(
+        "--engine",
+        &asked.join(","),
+        &format!(
+            "{} alone: the coefficients '{name}' correct {}'s Glossy (leave out --coefficients to build every engine's groups from the presets)",
+            engine.key(),
+            engine.label()
+        ),
+    ))
+}
+
 /// Writes what `g` asks for; nothing is written if anything fails.
 pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
     // Inputs and coefficients are checked before Blender is looked for: bad input fails fast.
@@ -142,6 +174,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         .as_deref()
         .map(|name| Coefficients::load(name).map(|c| (c, name)))
         .transpose()?;
+    let engines = engines_of(g, pinned.as_ref().map(|(c, name)| (c, *name)))?;
     let needs_blender = g.blend.is_some() || g.into.is_some() || g.extension.is_some();
     let blender = if needs_blender {
         let blender = g.blender.find(progress)?;
@@ -156,7 +189,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     // in, so one script serves every version.
     let curves = match &pinned {
         Some((coefficients, name)) => Curves::Pinned { coefficients, name },
-        None => Curves::Presets,
+        None => Curves::Presets(&engines),
     };
     let mut params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
     // A new library (.blend or extension) gets previews, and the catalogs of the
@@ -189,12 +222,19 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         blender: blender.as_ref().map(|b| b.version_string.clone()),
         coefficients: match (&pinned, &blender) {
             (Some((_, name)), _) => name.to_string(),
-            (None, Some(b)) => preset_for(b.version).to_string(),
-            (None, None) => format!(
-                "{} or {}, for the Blender the script runs in",
-                preset_for(BlenderVersion::OLDEST),
-                preset_for(BlenderVersion::HEIGHT_CORRELATED_FROM)
-            ),
+            (None, blender) => engines
+                .iter()
+                .map(|&engine| match (engine, blender) {
+                    (Engine::Eevee, _) => preset_for(engine, BlenderVersion::OLDEST).to_string(),
+                    (Engine::Cycles, Some(b)) => preset_for(engine, b.version).to_string(),
+                    (Engine::Cycles, None) => format!(
+                        "{} or {}, for the Blender the script runs in",
+                        preset_for(engine, BlenderVersion::OLDEST),
+                        preset_for(engine, BlenderVersion::HEIGHT_CORRELATED_FROM)
+                    ),
+                })
+                .collect::<Vec<_>>()
+                .join("; "),
         },
         script: None,
         blend: None,

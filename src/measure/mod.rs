@@ -1,12 +1,13 @@
 //! ① Measure: the physics. The microfacet distributions (`microfacet`), the Glossy BSDF as
 //! Cycles evaluates it (`glossy`), its albedo by quadrature (`albedo`), the masking family of
-//! each Blender version (`version`), the normal a glossy BSDF shades with (`shading_normal`),
-//! the dielectric Fresnel (`fresnel`) and the coat of the layered shader (`coat`), and the
-//! classic BRDF set (`brdf`).
+//! each Blender version (`version`), the BSDF each render engine evaluates (`engine`), the
+//! normal a glossy BSDF shades with (`shading_normal`), the dielectric Fresnel (`fresnel`)
+//! and the coat of the layered shader (`coat`), and the classic BRDF set (`brdf`).
 
 pub mod albedo;
 pub mod brdf;
 pub mod coat;
+pub mod engine;
 pub mod fresnel;
 pub mod glossy;
 pub mod microfacet;
@@ -14,6 +15,7 @@ pub mod shading_normal;
 pub mod version;
 
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
+pub use engine::Engine;
 pub use glossy::Glossy;
 pub use microfacet::{Distribution, Masking, Microfacet, Polar, Roughness};
 pub use version::BlenderVersion;

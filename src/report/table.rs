@@ -3,6 +3,7 @@
 use std::fmt::Write as _;
 
 use crate::generate::{ColorModel, Mode};
+use crate::measure::Engine;
 use crate::verify::VerifyReport;
 
 /// The verdict as a terminal table: a title line, one row per sphere, the references,
@@ -20,17 +21,15 @@ pub fn render(report: &VerifyReport) -> String {
             report.color_model.key()
         )
     };
+    let engine = match report.engine {
+        Engine::Cycles => format!("{} masking", i.masking),
+        Engine::Eevee => "EEVEE: every distribution renders as GGX".to_string(),
+    };
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "Blender {} ({} masking) · coefficients {} · {} px per sphere, {} spp, seed {} · rendered in {:.1} s{colour}",
-        i.blender_version,
-        i.masking,
-        report.coefficients,
-        i.cell,
-        i.samples,
-        i.seed,
-        i.render_seconds
+        "Blender {} ({engine}) · coefficients {} · {} px per sphere, {} spp, seed {} · rendered in {:.1} s{colour}",
+        i.blender_version, report.coefficients, i.cell, i.samples, i.seed, i.render_seconds
     );
     let average = |v: [f64; 3]| v.iter().sum::<f64>() / 3.0;
     let layered = report.mode == Mode::Layered;
@@ -43,12 +42,24 @@ pub fn render(report: &VerifyReport) -> String {
             "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of what the layered coat promises"
         );
     }
+    // An EEVEE sweep shows, beside each plain sphere, what Cycles renders for it.
+    let eevee = report.engine == Engine::Eevee;
+    let cycles_column = |v: Option<f64>| match (eevee, v) {
+        (false, _) => String::new(),
+        (true, Some(v)) => format!(" {:>9.2}%", 100.0 * v),
+        (true, None) => format!(" {:>10}", ""),
+    };
     let _ = writeln!(
         s,
-        "{:<w$} {:>5} {:>12} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
+        "{:<w$} {:>5} {:>12}{} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
         if layered { "coat" } else { "distribution" },
         "r",
         "uncorrected",
+        if eevee {
+            format!(" {:>10}", "in Cycles")
+        } else {
+            String::new()
+        },
         "corrected",
         "±SE",
         "predicted",
@@ -58,10 +69,11 @@ pub fn render(report: &VerifyReport) -> String {
     for r in &report.rows {
         let _ = writeln!(
             s,
-            "{:<w$} {:>5} {:>11.2}% {:>10.2}% {:>6.2}% {:>9.2}% {:>6.1}% {:>7.2}%  {}",
+            "{:<w$} {:>5} {:>11.2}%{} {:>10.2}% {:>6.2}% {:>9.2}% {:>6.1}% {:>7.2}%  {}",
             r.series(),
             r.roughness,
             100.0 * r.uncorrected_brightness,
+            cycles_column(r.cycles_uncorrected),
             100.0 * r.brightness,
             100.0 * r.corrected.standard_error / average(r.target),
             100.0 * r.predicted_corrected,
@@ -73,10 +85,11 @@ pub fn render(report: &VerifyReport) -> String {
     for r in &report.reference {
         let _ = writeln!(
             s,
-            "{:<w$} {:>5} {:>11.2}% {:>10} {:>6.2}% {:>10} {:>6.1}%  reference",
+            "{:<w$} {:>5} {:>11.2}%{} {:>10} {:>6.2}% {:>10} {:>6.1}%  reference",
             r.series(report.mode),
             r.roughness,
             100.0 * r.brightness,
+            cycles_column(None),
             "",
             100.0 * r.stats.standard_error / average(report.color),
             "",

@@ -17,7 +17,7 @@ use crate::Error;
 use crate::blender::{Blender, BlenderOptions};
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{Distribution, Roughness, coat};
+use crate::measure::{Distribution, Engine, Roughness, coat};
 use crate::progress::Progress;
 
 /// What `verify` renders and how it judges it.
@@ -87,6 +87,7 @@ pub fn verify(v: &VerifyOptions, progress: &dyn Progress) -> Result<Verification
     check_roughness(&v.roughness)?;
     check_ior(v.mode, &v.ior)?;
     check_color(v.color)?;
+    check_engine(v.render.engine, v.mode)?;
     if let Some(name) = &v.coefficients {
         distributions_of(v, &Coefficients::load(name)?, name)?;
     }
@@ -102,8 +103,9 @@ pub fn verify_with(
 ) -> Result<Verification, Error> {
     check_roughness(&v.roughness)?;
     check_ior(v.mode, &v.ior)?;
+    check_engine(v.render.engine, v.mode)?;
     let (coefficients, source) =
-        Coefficients::load_or_preset(v.coefficients.as_deref(), blender.version)?;
+        Coefficients::load_or_preset(v.coefficients.as_deref(), v.render.engine, blender.version)?;
     let distributions = distributions_of(v, &coefficients, &source)?;
     let roughness: Vec<f64> = v.roughness.iter().map(|r| r.get()).collect();
     let plan = Plan::verify(&distributions, &roughness, &v.ior, v.render);
@@ -138,6 +140,18 @@ pub fn verify_with(
     };
     let report = verdict::judge(&rendered, &sweep, v.judging, blender.version)?;
     Ok(Verification { report, rendered })
+}
+
+/// EEVEE renders the roughness and view modes; the layered groups are Cycles' only.
+fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
+    if engine == Engine::Eevee && mode == Mode::Layered {
+        return Err(Error::input(
+            "--engine",
+            engine.key(),
+            "cycles with --mode layered (the layered groups are calibrated and checked in Cycles only)",
+        ));
+    }
+    Ok(())
 }
 
 /// A colour every channel of which is finite and in [0, 1].

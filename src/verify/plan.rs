@@ -2,13 +2,14 @@
 //! row 0 at the top. Each distribution gets an uncorrected row and a corrected row; a final
 //! row holds Blender's own energy-conserving answer as the reference. In layered mode the
 //! rows repeat for every index of refraction, "uncorrected" is the Mix Shader artists build
-//! by hand and the reference is Principled BSDF.
+//! by hand and the reference is Principled BSDF. In EEVEE a last cell holds a white Diffuse
+//! sphere: how bright EEVEE's lighting itself is.
 
 use serde::Serialize;
 use std::path::Path;
 
 use crate::generate::{GenerateParams, GroupSpec, Mode};
-use crate::measure::Distribution;
+use crate::measure::{Distribution, Engine};
 
 /// What a sphere is shaded with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -22,6 +23,8 @@ pub enum Role {
     /// Blender's own energy-conserving answer: Glossy with `MULTI_GGX` (layered mode:
     /// Principled BSDF).
     Reference,
+    /// A white Diffuse BSDF: the engine's lighting (EEVEE Next's world probe loses 0.8 %).
+    Lighting,
 }
 
 impl Role {
@@ -33,6 +36,7 @@ impl Role {
             (Role::Uncorrected(d), _) => format!("{} uncorrected", d.label()),
             (Role::Corrected(d), _) => format!("{} corrected", d.label()),
             (Role::Reference, _) => reference_label(mode).to_string(),
+            (Role::Lighting, _) => "Diffuse BSDF".to_string(),
         }
     }
 }
@@ -66,6 +70,7 @@ pub struct Cell {
 /// Render settings with their reasons.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
+    pub engine: Engine,
     /// Pixels per sphere cell.
     pub cell: u32,
     pub samples: u32,
@@ -77,14 +82,30 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
+        RenderSettings::for_engine(Engine::Cycles)
+    }
+}
+
+impl RenderSettings {
+    /// The verify defaults of an engine.
+    pub fn for_engine(engine: Engine) -> Self {
         RenderSettings {
+            engine,
             cell: 64,
-            // 32 spp keeps the standard error of every sphere's mean ≤ 0.2 % (measured in
-            // 3.4, 4.5 and 5.0 over six seeds; 16 spp reaches 0.5 % in 3.4).
-            samples: 32,
+            samples: default_samples(engine),
             seed: 0,
             radius_fraction: 0.9,
         }
+    }
+}
+
+/// Samples per pixel unless told: Cycles 32 keeps the standard error of every sphere's mean
+/// ≤ 0.2 % (measured in 3.4, 4.5 and 5.0 over six seeds; 16 spp reaches 0.5 % in 3.4).
+/// EEVEE's furnace is deterministic: 1, 64 and 256 samples agree within 0.03 %.
+pub fn default_samples(engine: Engine) -> u32 {
+    match engine {
+        Engine::Cycles => 32,
+        Engine::Eevee => 1,
     }
 }
 
@@ -124,6 +145,24 @@ impl Plan {
             columns: roughness.len(),
             settings,
         }
+        .with_lighting()
+    }
+
+    /// EEVEE's plans end with a white Diffuse sphere, which says how bright its lighting is.
+    fn with_lighting(mut self) -> Self {
+        if self.settings.engine == Engine::Eevee {
+            self.cells.push(Cell {
+                role: Role::Lighting,
+                roughness: 0.0,
+                ior: None,
+            });
+        }
+        self
+    }
+
+    /// The white Diffuse sphere's cell (EEVEE only).
+    pub fn lighting(&self) -> Option<usize> {
+        self.cells.iter().position(|c| c.role == Role::Lighting)
     }
 
     /// Uncorrected spheres only (what `refresh` measures).
@@ -147,6 +186,7 @@ impl Plan {
             columns: roughness.len(),
             settings,
         }
+        .with_lighting()
     }
 
     pub fn rows(&self) -> usize {
@@ -199,6 +239,9 @@ impl Plan {
                     distribution: "MULTI_GGX",
                     roughness: c.roughness,
                 },
+                (Role::Lighting, _) => SphereSpec::Diffuse {
+                    roughness: c.roughness,
+                },
                 (Role::Corrected(d), ior) => SphereSpec::Group {
                     group: shader_of(d),
                     roughness: c.roughness,
@@ -209,6 +252,7 @@ impl Plan {
         FurnaceParams {
             generate: groups.clone(),
             furnace: FurnaceSection {
+                engine: self.settings.engine,
                 cell: self.settings.cell,
                 columns: self.columns,
                 samples: self.settings.samples,
@@ -244,10 +288,13 @@ pub enum SphereSpec {
     },
     /// Principled BSDF at its defaults, a dielectric of index `ior`.
     Principled { roughness: f64, ior: f64 },
+    /// A Diffuse BSDF of the sweep's colour (roughness 0: Lambert).
+    Diffuse { roughness: f64 },
 }
 
 #[derive(Clone, Debug, Serialize)]
 pub struct FurnaceSection {
+    pub engine: Engine,
     pub cell: u32,
     pub columns: usize,
     pub samples: u32,

@@ -10,7 +10,7 @@ use crate::Error;
 use crate::fit::{Coefficients, ColorSpace, preset_for};
 use crate::generate::{ColorModel, Mode};
 use crate::measure::coat::{Coat, multiscatter_tint};
-use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Glossy, Roughness, fresnel};
+use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Engine, Roughness, fresnel};
 
 /// Rings with fewer fully covered pixels than this are too noisy to judge flatness by (at
 /// 64 px per sphere, the outermost ring, μ ∈ [0.3, 0.4), holds 72 pixels: at 32 spp its
@@ -29,11 +29,25 @@ pub struct Judging {
 
 impl Default for Judging {
     fn default() -> Self {
-        Judging {
-            // 1 %: five times the largest standard error of a sphere's mean at 32 spp.
-            tolerance_percent: 1.0,
-            // 1.5 %: a ring holds fewer pixels than a sphere, so it is noisier.
-            ring_tolerance_percent: 1.5,
+        Judging::for_engine(Engine::Cycles)
+    }
+}
+
+impl Judging {
+    pub fn for_engine(engine: Engine) -> Self {
+        match engine {
+            Engine::Cycles => Judging {
+                // 1 %: five times the largest standard error of a sphere's mean at 32 spp.
+                tolerance_percent: 1.0,
+                // 1.5 %: a ring holds fewer pixels than a sphere, so it is noisier.
+                ring_tolerance_percent: 1.5,
+            },
+            // EEVEE has no noise but its own errors: Next's lighting is 0.8 % dark, and
+            // its split-sum table is within 0.5 % of the integrator's.
+            Engine::Eevee => Judging {
+                tolerance_percent: 2.0,
+                ring_tolerance_percent: 2.0,
+            },
         }
     }
 }
@@ -62,11 +76,15 @@ pub struct Row {
     pub brightness: f64,
     /// The worst channel's |mean / target − 1|.
     pub deviation: f64,
-    /// What the integrator predicts for the uncorrected sphere: E_avg(r) for this Blender's
-    /// masking (0–1); in layered mode the Mix Shader's mean relative to `target`.
+    /// What the integrator predicts for the uncorrected sphere: E_avg(r) of the BSDF the
+    /// engine renders (0–1); in layered mode the Mix Shader's mean relative to `target`.
     pub predicted_uncorrected: f64,
+    /// In an EEVEE sweep: what Cycles renders for the uncorrected sphere in this Blender
+    /// (the integrator's E_avg(r) for its distribution and masking).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycles_uncorrected: Option<f64>,
     /// What the coefficients should give relative to `target` (gain(r) · E_avg(r) for a
-    /// white sphere; 1 in the view modes).
+    /// white sphere; 1 in the view modes, unless the groups are another engine's).
     pub predicted_corrected: f64,
     /// What the colour model promises each view-cosine ring of the corrected sphere (in the
     /// order of its rings), per channel: for a pixel-exact correction, every pixel's target.
@@ -120,6 +138,14 @@ impl ReferenceSphere {
 #[derive(Clone, Debug, Serialize)]
 pub struct VerifyReport {
     pub coefficients: String,
+    /// The engine that rendered the sweep.
+    pub engine: Engine,
+    /// The engine the coefficients (and so the corrected spheres' groups) are calibrated for.
+    pub groups_engine: Engine,
+    /// EEVEE: a white Diffuse sphere's mean relative to the colour (how bright the engine's
+    /// lighting is; the corrections cannot do better).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lighting: Option<f64>,
     pub mode: Mode,
     /// The spheres' colour, and what the corrections promise for it.
     pub color: [f64; 3],
@@ -233,6 +259,10 @@ pub fn judge(
     } = *sweep;
     let plan = &rendered.plan;
     let masking = version.masking();
+    // What renders, and what the groups were calibrated for (Cycles groups may be rendered
+    // in EEVEE to show what they do there).
+    let engine = plan.settings.engine;
+    let groups_engine = coefficients.engine();
     let integrator = AlbedoIntegrator::default();
     let tolerance = judging.tolerance_percent / 100.0;
     let find = |role: Role, r: f64, ior: Option<f64>| {
@@ -245,7 +275,9 @@ pub fn judge(
         for &d in distributions {
             let curve = &coefficients.distributions[&d].curve;
             for &r in roughness {
-                let glossy = Glossy::new(d, masking, Roughness::new(r)?);
+                let roughness = Roughness::new(r)?;
+                let glossy = engine.glossy(d, masking, roughness);
+                let calibrated = groups_engine.glossy(d, masking, roughness);
                 let coat = ior.map(|n| Coat::new(&integrator, glossy, n));
                 let e_avg = match &coat {
                     Some(coat) => coat.e_avg(),
@@ -304,6 +336,9 @@ pub fn judge(
                     roughness: r,
                     ior,
                     cells,
+                    cycles_uncorrected: (engine != Engine::Cycles).then(|| {
+                        integrator.average_albedo(&Engine::Cycles.glossy(d, masking, roughness))
+                    }),
                     uncorrected_brightness: relative(
                         uncorrected.mean_rgb,
                         if coat.is_some() { target } else { color },
@@ -320,7 +355,14 @@ pub fn judge(
                     predicted_uncorrected,
                     predicted_corrected: match mode {
                         Mode::Roughness => relative(color.map(achieved), target).0,
-                        Mode::View | Mode::Multiscatter | Mode::Layered => 1.0,
+                        _ if calibrated == glossy => 1.0,
+                        // Another engine's table: gain E/E' per pixel, or E + (1 − E').
+                        Mode::View => integrator.hemispherical_average(|mu| {
+                            integrator.directional_albedo(&glossy, mu)
+                                / integrator.directional_albedo(&calibrated, mu)
+                        }),
+                        Mode::Multiscatter => 1.0 + e_avg - integrator.average_albedo(&calibrated),
+                        Mode::Layered => 1.0,
                     },
                 });
             }
@@ -329,7 +371,7 @@ pub fn judge(
     let mut reference = Vec::new();
     for &ior in &iors {
         for &r in roughness {
-            let ggx = Glossy::new(Distribution::Ggx, masking, Roughness::new(r)?);
+            let ggx = engine.glossy(Distribution::Ggx, masking, Roughness::new(r)?);
             // Multiscatter GGX promises what a corrected GGX sphere does; Principled BSDF
             // what a layered GGX coat does.
             let promise = match ior {
@@ -351,9 +393,32 @@ pub fn judge(
         }
     }
     let pass = rows.iter().all(|r| r.pass);
+    let lighting = plan
+        .lighting()
+        .map(|cell| relative(rendered.stats[cell].mean_rgb, color).0);
     let mut notes = Vec::new();
+    if let Some(l) = lighting {
+        notes.push(format!(
+            "{engine}'s lighting: a white Diffuse sphere renders at {:.2} % in this sweep (EEVEE Next's world probe loses about 0.8 %; EEVEE Legacy none), so no sphere can come out brighter than that.",
+            100.0 * l
+        ));
+    }
+    if groups_engine != engine {
+        notes.push(format!(
+            "The coefficients '{source}' correct {groups_engine}'s Glossy, rendered here in {engine}{}: use --coefficients {} for {engine}'s own groups.",
+            match engine {
+                Engine::Eevee => ", which renders every distribution as its GGX",
+                Engine::Cycles => "",
+            },
+            preset_for(engine, version)
+        ));
+    }
     for (d, e) in &coefficients.distributions {
-        if e.masking != masking && e.color_space == ColorSpace::Linear && distributions.contains(d)
+        if e.masking != masking
+            && e.engine == Engine::Cycles
+            && engine == Engine::Cycles
+            && e.color_space == ColorSpace::Linear
+            && distributions.contains(d)
         {
             notes.push(format!(
                 "{}: the coefficients were fitted for {} masking, but Blender {} uses {} masking; use --coefficients {}.",
@@ -361,7 +426,7 @@ pub fn judge(
                 e.masking,
                 version,
                 masking,
-                preset_for(version)
+                preset_for(engine, version)
             ));
         }
     }
@@ -419,6 +484,9 @@ pub fn judge(
     }
     Ok(VerifyReport {
         coefficients: source.to_string(),
+        engine,
+        groups_engine,
+        lighting,
         mode,
         color,
         color_model,
