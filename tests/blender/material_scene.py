@@ -142,7 +142,7 @@ def variant_material(scene, variant):
 def build_scene(scene):
     render_scene = bpy.context.scene
     size = scene["resolution"]
-    settings = {"cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
+    settings = {"engine": "cycles", "cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
     furnace_render_settings(render_scene, settings, 1, 1)  # noqa: F821 -- furnace.py
     # A point-like pixel filter: every sample of a pixel hits the same point.
     render_scene.cycles.filter_width = 0.01
