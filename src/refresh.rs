@@ -158,7 +158,7 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
         weighting: Weighting::Relative,
         target: Target::Mean,
         // The masking of the BSDF the engine renders.
-        masking: engine.model(Distribution::Ggx, masking).1,
+        masking: engine.masking(masking),
         engine,
         provenance: Provenance {
             source: Source::Blender,

@@ -15,24 +15,9 @@ use std::path::Path;
 const ROUGHNESS: &str = "0.25,0.5,0.75,1";
 
 fn verify(blender: &Path, extra: &[&str]) -> (i32, Value) {
-    let out = common::gloffuse()
-        .args([
-            "verify",
-            "--json",
-            "--no-provision",
-            "--engine",
-            "eevee",
-            "-r",
-            ROUGHNESS,
-        ])
-        .args(extra)
-        .arg("--blender")
-        .arg(blender)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        serde_json::from_slice(&out.stdout).unwrap_or(Value::Null),
+    common::verify_json(
+        blender,
+        &[&["--engine", "eevee", "-r", ROUGHNESS], extra].concat(),
     )
 }
 

@@ -11,17 +11,7 @@ use serde_json::Value;
 use std::path::Path;
 
 fn verify(blender: &Path, extra: &[&str]) -> (i32, Value) {
-    let out = common::gloffuse()
-        .args(["verify", "--json", "--no-provision", "--mode", "layered"])
-        .args(extra)
-        .arg("--blender")
-        .arg(blender)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        serde_json::from_slice(&out.stdout).unwrap_or(Value::Null),
-    )
+    common::verify_json(blender, &[&["--mode", "layered"], extra].concat())
 }
 
 fn f(v: &Value) -> f64 {

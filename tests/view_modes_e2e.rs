@@ -7,25 +7,9 @@ mod common;
 use serde_json::Value;
 
 fn verify(blender: &std::path::Path, mode: &str) -> (i32, Value) {
-    let out = common::gloffuse()
-        .args([
-            "verify",
-            "--json",
-            "--no-provision",
-            "--spp",
-            "64",
-            "-r",
-            "0.25,0.5,0.75,1",
-            "--mode",
-            mode,
-            "--blender",
-        ])
-        .arg(blender)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        serde_json::from_slice(&out.stdout).unwrap_or(Value::Null),
+    common::verify_json(
+        blender,
+        &["--spp", "64", "-r", "0.25,0.5,0.75,1", "--mode", mode],
     )
 }
 

@@ -43,17 +43,15 @@ pub const PRESETS: [(&str, &str, &str); 4] = [
 /// The preset fitted for what `engine` renders in `version`: `blender-3` or `blender-4`
 /// (Cycles, by masking family) or `eevee`.
 pub fn preset_for(engine: Engine, version: BlenderVersion) -> &'static str {
-    match engine {
-        Engine::Cycles => preset_for_masking(version.masking()),
-        Engine::Eevee => "eevee",
-    }
+    preset_for_masking(engine, version.masking())
 }
 
-/// The preset fitted for a masking family.
-pub fn preset_for_masking(masking: Masking) -> &'static str {
-    match masking {
-        Masking::Separable => "blender-3",
-        Masking::HeightCorrelated => "blender-4",
+/// The preset fitted for what `engine` renders where Cycles uses `masking`.
+pub fn preset_for_masking(engine: Engine, masking: Masking) -> &'static str {
+    match (engine, masking) {
+        (Engine::Cycles, Masking::Separable) => "blender-3",
+        (Engine::Cycles, Masking::HeightCorrelated) => "blender-4",
+        (Engine::Eevee, _) => "eevee",
     }
 }
 
@@ -374,7 +372,7 @@ impl Coefficients {
             Target::Center => &[1.0],
         };
         // The masking of the curve's model (every distribution's, for one engine).
-        let (_, masking) = engine.model(Distribution::Ggx, version.masking());
+        let masking = engine.masking(version.masking());
         let spec = FitSpec {
             degree,
             weighting,

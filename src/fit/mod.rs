@@ -30,7 +30,7 @@ pub fn fit_points(
         degree,
         weighting,
         target,
-        masking: engine.model(distribution, version.masking()).1,
+        masking: engine.masking(version.masking()),
         engine,
         provenance: Provenance {
             source: Source::Points,

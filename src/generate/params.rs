@@ -335,7 +335,7 @@ impl GenerateParams {
                         (coefficients.clone(), name.to_string())
                     }
                     Curves::Presets(_) => {
-                        let name = preset_for_family(engine, masking);
+                        let name = preset_for_masking(engine, masking);
                         (Coefficients::load(name)?, name.to_string())
                     }
                 };
@@ -373,21 +373,12 @@ impl GenerateParams {
     }
 }
 
-/// The masking families an engine's groups carry: Cycles', or EEVEE's one model (the same in
-/// every Blender version).
+/// The masking families an engine's groups carry: each of Cycles' `families` as that
+/// engine renders it, once (EEVEE's one model serves every Blender version).
 fn engine_families(engine: Engine, families: &[Masking]) -> Vec<Masking> {
-    match engine {
-        Engine::Cycles => families.to_vec(),
-        Engine::Eevee => vec![engine.model(Distribution::Ggx, Masking::Separable).1],
-    }
-}
-
-/// The preset of one engine's masking family.
-fn preset_for_family(engine: Engine, masking: Masking) -> &'static str {
-    match engine {
-        Engine::Cycles => preset_for_masking(masking),
-        Engine::Eevee => "eevee",
-    }
+    let mut rendered: Vec<Masking> = families.iter().map(|&m| engine.masking(m)).collect();
+    rendered.dedup();
+    rendered
 }
 
 /// One distribution's groups for one engine: names, and per family the curve and the tables

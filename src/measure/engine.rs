@@ -40,13 +40,22 @@ impl Engine {
         *self == Engine::Cycles
     }
 
+    /// The masking this engine evaluates in a Blender whose Cycles uses `masking`.
+    pub fn masking(self, masking: Masking) -> Masking {
+        match self {
+            Engine::Cycles => masking,
+            Engine::Eevee => Masking::Separable,
+        }
+    }
+
     /// The distribution and masking this engine evaluates for a Glossy node of
     /// `distribution` in a Blender whose Cycles uses `masking`.
     pub fn model(self, distribution: Distribution, masking: Masking) -> (Distribution, Masking) {
-        match self {
-            Engine::Cycles => (distribution, masking),
-            Engine::Eevee => (Distribution::Ggx, Masking::Separable),
-        }
+        let distribution = match self {
+            Engine::Cycles => distribution,
+            Engine::Eevee => Distribution::Ggx,
+        };
+        (distribution, self.masking(masking))
     }
 
     /// The BSDF this engine renders for a Glossy node of `distribution` and `roughness`.

@@ -10,6 +10,22 @@ pub fn gloffuse() -> assert_cmd::Command {
     assert_cmd::Command::cargo_bin("gloffuse").expect("the gloffuse binary is built")
 }
 
+/// `gloffuse verify --json --no-provision ARGS --blender BLENDER`: its exit code and the
+/// JSON report (null if stdout holds none).
+pub fn verify_json(blender: &std::path::Path, args: &[&str]) -> (i32, serde_json::Value) {
+    let out = gloffuse()
+        .args(["verify", "--json", "--no-provision"])
+        .args(args)
+        .arg("--blender")
+        .arg(blender)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        serde_json::from_slice(&out.stdout).unwrap_or(serde_json::Value::Null),
+    )
+}
+
 /// A headless browser for the report page: `$GLOFFUSE_TEST_CHROMIUM`, else Debian's
 /// `/usr/bin/chromium` (which `scripts/test.sh` installs). A missing one fails the test
 /// unless `GLOFFUSE_SKIP_BROWSER_TESTS=1`, and then the test says what it skipped.
