@@ -12,12 +12,12 @@
 #
 # A travels as one packed float image: slices side by side, slice k for the
 # index whose z = F0^(1/4) is k z_max / (K - 1), each slice a grid over (r, mu)
-# read at pixel centres; the group reads the two slices around its IOR and
-# mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
+# packed by cell as the E(mu, r) image is; the group reads the cell in the two
+# slices around its IOR and mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
 # from the shading-normal group (normal_group.py).
 #
 # One part of the script the gloffuse binary concatenates, after
-# view_groups.py (whose albedo_lookup it uses). Functions and constants only.
+# view_groups.py (whose albedo_lookup, grid_cell, read_cell and bilinear it uses). Functions and constants only.
 # ---------------------------------------------------------------------------
 
 LAYERED_IOR_MIN = 1.0
@@ -45,71 +45,53 @@ def layered_sockets():
 
 
 def coat_image(layered):
-    """The packed float image of A(mu, r, IOR).
-    Row i is mu = i / (size - 1) (bottom row first); slice k fills columns
-    k size .. (k + 1) size - 1, column j of it r = j / (size - 1). A is stored in
-    every channel."""
+    """The packed float image of A(mu, r, IOR), slice by slice side by side:
+    slice k packed by cell (see corner_cells in view_groups.py) fills columns
+    k (size - 1) .. (k + 1) (size - 1) - 1, row i the cells between
+    mu = i / (size - 1) and (i + 1) / (size - 1)."""
     table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
-    width = size * slices
     values = finite_list(table["values"], "layered.coat_table.values")
-    if len(values) != width * size:
+    if len(values) != size * slices * size:
         raise ValueError("layered.coat_table holds %d values, not %d x %d"
-                         % (len(values), width, size))
+                         % (len(values), size * slices, size))
+    cells = size - 1
+    packed = [corner_cells(lambda i, j, k=k: values[(i * slices + k) * size + j], size, size)
+              for k in range(slices)]
     pixels = []
-    for value in values:
-        pixels.extend((value, value, value, value))
-    return packed_float_image(layered["coat_image"], width, size, pixels)  # view_groups.py
+    for i in range(cells):
+        for slice_pixels in packed:
+            pixels.extend(slice_pixels[4 * cells * i:4 * cells * (i + 1)])
+    return packed_float_image(layered["coat_image"], cells * slices, cells, pixels)
 
 
-def coat_lookup(tree, layered, chain, roughness, mu, ior, x, frame):
-    """Nodes that read A(mu, r, IOR): the two slices around the index, mixed
-    linearly in z = F0^(1/4). Returns the A socket."""
+def coat_lookup(tree, layered, chain, roughness, mu, ior, frame):
+    """Nodes that read A(mu, r, IOR): the two slices around the index, each
+    interpolated bilinearly in (r, mu), mixed linearly in z = F0^(1/4).
+    Returns the A socket."""
     table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4), for n clamped to the table's range.
-    n = chain.math("MINIMUM", "n = min(IOR, %g)" % LAYERED_IOR_MAX,
-                   chain.math("MAXIMUM", "max(IOR, 1)", ior, LAYERED_IOR_MIN), LAYERED_IOR_MAX)
+    n = chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, LAYERED_IOR_MAX), ior,
+                    LAYERED_IOR_MIN, LAYERED_IOR_MAX)
     ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
                        chain.math("ADD", "n + 1", n, 1.0))
     z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
     s = chain.math("MULTIPLY", "slice position z (K-1) / z_max", z, (slices - 1) / z_max)
-    k0 = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
-                    slices - 2.0)
-    t = chain.math("SUBTRACT", "t = position - k", s, k0)
-    # Pixel centres of slice k: u = (k W + 1/2 + r (W - 1)) / (K W); the next slice is 1/K on.
-    within = chain.math("MULTIPLY_ADD", "r (W-1) + 1/2", roughness, size - 1.0, 0.5)
-    u0 = chain.math("DIVIDE", "u of slice k",
-                    chain.math("MULTIPLY_ADD", "k W + r (W-1) + 1/2", k0, float(size), within),
-                    float(size * slices))
-    u1 = chain.math("ADD", "u of slice k + 1", u0, 1.0 / slices)
-    v = chain.math("MULTIPLY_ADD", "v = mu (H-1)/H + 1/2H", mu, (size - 1.0) / size, 0.5 / size)
+    k = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
+                   slices - 2.0)
+    t = chain.math("SUBTRACT", "t = position - k", s, k)
+    column, across = grid_cell(chain, roughness, size, "r")  # view_groups.py
+    row, up = grid_cell(chain, mu, size, "mu")
     image = coat_image(layered)
-    samples = []
-    for index, u in enumerate((u0, u1)):
-        uv = tree.nodes.new("ShaderNodeCombineXYZ")
-        uv.name = "uv %d" % index
-        set_parent(uv, frame)
-        uv.location = (FRAME_INSET + COLUMN_STEP * x, -ROW_STEP * (4 + 2 * index))
-        tree.links.new(u, uv.inputs["X"])
-        tree.links.new(v, uv.inputs["Y"])
-        texture = tree.nodes.new("ShaderNodeTexImage")
-        texture.name = "A(mu, r) slice %s" % ("k", "k + 1")[index]
-        texture.label = short_label("coat A(mu, r, IOR) %d x %d x %d, slice %s"
-                                    % (size, size, slices, ("k", "k + 1")[index]))
-        texture.image = image
-        texture.interpolation = "Linear"
-        texture.extension = "EXTEND"
-        texture.width = 240.0
-        set_parent(texture, frame)
-        texture.location = (FRAME_INSET + COLUMN_STEP * (x + 1), -ROW_STEP * (4 + 2 * index))
-        tree.links.new(uv.outputs[0], texture.inputs["Vector"])
-        samples.append(texture.outputs["Alpha"])
-    chain.column = max(chain.column, x + 3)
-    difference = chain.math("SUBTRACT", "A(k + 1) - A(k)", samples[1], samples[0])
-    return chain.math("MULTIPLY_ADD", "A = A(k) + t (A(k + 1) - A(k))", difference, t, samples[0],
-                      name="Coat albedo")
+    # Slice k's cells start at column k (size - 1); slice k + 1's one slice on.
+    first = chain.math("MULTIPLY_ADD", "column in slice k", k, size - 1.0, column)
+    second = chain.math("ADD", "column in slice k + 1", first, size - 1.0)
+    a = [bilinear(chain, read_cell(chain, image, c, row, "A(mu, r) slice " + name), across, up,
+                  "A slice " + name)
+         for c, name in ((first, "k"), (second, "k + 1"))]
+    return chain.mix_value("A = A(k) + t (A(k + 1) - A(k))", t, a[0], a[1])
 
 
 def build_layered_group(spec, params):
@@ -125,9 +107,9 @@ def build_layered_group(spec, params):
                       "Coat albedo A(mu, r, IOR) and E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, params, group_in, 1, frame)
-    albedo, _e_avg, column = albedo_lookup(tree, layered, r, mu, 2, frame)
+    albedo, _, column = albedo_lookup(tree, layered, r, mu, 2, frame)
     chain = Chain(tree, frame, column=column, y=0.0)
-    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], column, frame)
+    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], frame)
     weight = chain.math("DIVIDE", "A / E", a, albedo, name="Coat weight")
     glossy_color = chain.vector("SCALE", "Specular Tint × A / E", group_in.outputs["Specular Tint"],
                                 weight, name="Coat colour")

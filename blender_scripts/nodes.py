@@ -255,6 +255,11 @@ class Chain:
             self._row = 0
             self.column += 1
 
+    def skip(self, columns):
+        """Leave `columns` columns to other nodes; go on at the top of the next."""
+        self.column += columns + (1 if self._row else 0)
+        self._row = 0
+
     def _feed(self, socket, value):
         if isinstance(value, bpy.types.NodeSocket):
             self.tree.links.new(value, socket)
@@ -293,10 +298,20 @@ class Chain:
         step = self.vector("SCALE", label + ": scaled", difference, flag)
         return self.vector("ADD", label, when_zero, step)
 
-    def select_value(self, label, flag, when_zero, when_one):
-        """when_zero + flag (when_one - when_zero) for floats; flag is 0 or 1."""
-        difference = self.math("SUBTRACT", label + ": difference", when_one, when_zero)
-        return self.math("MULTIPLY_ADD", label, difference, flag, when_zero)
+    def mix_value(self, label, t, at_zero, at_one):
+        """at_zero + t (at_one - at_zero) for floats: a 0/1 flag selects, a
+        fraction interpolates linearly."""
+        difference = self.math("SUBTRACT", label + ": difference", at_one, at_zero)
+        return self.math("MULTIPLY_ADD", label, difference, t, at_zero)
+
+    def clamp(self, label, value, low, high):
+        """A Clamp node: value clamped to [low, high]."""
+        node = self.tree.nodes.new("ShaderNodeClamp")
+        node.clamp_type = "MINMAX"
+        for socket, operand in zip(node.inputs, (value, low, high)):
+            self._feed(socket, operand)
+        self._place(node, label, None)
+        return node.outputs[0]
 
 
 def asset_fields(params, kind):

@@ -91,13 +91,13 @@ def _raised_normal_3_0(chain, I, Ng, X, Ix, Iz, t, a, minus_iz):
     both_up = chain.math("MULTIPLY", "R1, R2 ≥ 1e-5",
                          chain.math("SUBTRACT", "R1 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R1 < 1e-5", r1, 1e-5)),
                          chain.math("SUBTRACT", "R2 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R2 < 1e-5", r2, 1e-5)))
-    first_if_both = chain.select_value("pick 1 of two", both_up,
-                                       chain.math("GREATER_THAN", "R1 > R2", r1, r2),
-                                       chain.math("LESS_THAN", "R1 < R2", r1, r2))
+    first_if_both = chain.mix_value("pick 1 of two", both_up,
+                                    chain.math("GREATER_THAN", "R1 > R2", r1, r2),
+                                    chain.math("LESS_THAN", "R1 < R2", r1, r2))
     both = chain.math("MULTIPLY", "both valid", v1, v2)
-    first = chain.select_value("pick 1", both, v1, first_if_both)
-    nx = chain.select_value("N'x", first, x2, x1)
-    nz = chain.select_value("N'z", first, z2, z1)
+    first = chain.mix_value("pick 1", both, v1, first_if_both)
+    nx = chain.mix_value("N'x", first, x2, x1)
+    nz = chain.mix_value("N'z", first, z2, z1)
     raised = chain.vector("ADD", "N' = N'x X + N'z Ng",
                           chain.vector("SCALE", "N'x X", X, nx),
                           chain.vector("SCALE", "N'z Ng", Ng, nz))

@@ -4,11 +4,12 @@
 # group, and the multiscatter group Glossy + Diffuse(Color x (1 - E(mu, r))).
 #
 # The directional albedo E(mu, r) travels as a table in the parameters and is
-# packed into the .blend as a 32-bit float OpenEXR image (R = B = A = E, G =
-# E_avg(r)). An Image Texture node samples it at (u, v) = pixel centres of
-# (r, mu), with mu the view cosine at the normal the BSDF really uses (the
-# normal group of normal_group.py), so Cycles' linear interpolation
-# reproduces the table exactly at its grid points.
+# packed into the .blend as a 32-bit float OpenEXR image, one pixel per cell of
+# the table holding the cell's four corners, plus a row for E_avg(r). The group
+# reads the cell (r, mu) falls in with Closest interpolation and interpolates
+# bilinearly in Math nodes, with mu the view cosine at the normal the BSDF
+# really uses (the normal group of normal_group.py): Cycles and EEVEE read the
+# same numbers, the table's own at its grid points.
 #
 # Colour (params["color_model"]): "exact" multiplies Color by 1 / E, so the
 # surface's albedo is Color; "physical" tints the energy multiple bounces add
@@ -40,11 +41,25 @@ def view_shader_sockets(output_description):
     ]
 
 
+def corner_cells(value_at, rows, columns):
+    """RGBA pixels (bottom row first) of a table of rows x columns samples
+    packed by cell: pixel (i, j) of the (columns - 1) x (rows - 1) image holds
+    the corners of cell (i, j), (v[i][j], v[i][j+1], v[i+1][j], v[i+1][j+1]),
+    so one unfiltered read gives everything its bilinear interpolation needs."""
+    pixels = []
+    for i in range(rows - 1):
+        for j in range(columns - 1):
+            pixels.extend((value_at(i, j), value_at(i, j + 1),
+                           value_at(i + 1, j), value_at(i + 1, j + 1)))
+    return pixels
+
+
 def albedo_image(view):
     """The packed float image holding E(mu, r): reused by name, resized if needed.
-    Row i is mu = i / (height - 1) (row 0 at the bottom, Blender's order), column
-    j is r = j / (width - 1); E is stored in R, B and alpha, E_avg(r) in G
-    (channel packed)."""
+    Row i < height - 1 holds the cells between mu = i / (height - 1) and
+    (i + 1) / (height - 1) (see corner_cells), column j those between
+    r = j / (width - 1) and (j + 1) / (width - 1); the top row holds E_avg(r)
+    the same way: (E_avg(r_j), E_avg(r_j+1), E_avg(r_j), E_avg(r_j+1))."""
     table = view["table"]
     width, height = int(table["width"]), int(table["height"])
     values = finite_list(table["values"], "view.table.values")
@@ -53,10 +68,9 @@ def albedo_image(view):
     average = finite_list(table["average"], "view.table.average")
     if len(average) != width:
         raise ValueError("view.table.average holds %d values, not %d" % (len(average), width))
-    pixels = []
-    for index, value in enumerate(values):
-        pixels.extend((value, average[index % width], value, value))
-    return packed_float_image(view["image"], width, height, pixels)
+    pixels = corner_cells(lambda i, j: values[i * width + j], height, width)
+    pixels += corner_cells(lambda i, j: average[j], 2, width)
+    return packed_float_image(view["image"], width - 1, height, pixels)
 
 
 def packed_float_image(name, width, height, pixels):
@@ -77,50 +91,82 @@ def packed_float_image(name, width, height, pixels):
     return image
 
 
-def albedo_lookup(tree, view, roughness_socket, mu_socket, x, frame):
-    """Nodes that read E(mu, r) and E_avg(r) for the clamped roughness and the
-    view cosine; x is the first column. Returns (E, E_avg, next column)."""
-    nodes, links = tree.nodes, tree.links
-    table = view["table"]
-    width, height = int(table["width"]), int(table["height"])
+def grid_cell(chain, coordinate, samples, name):
+    """Where `coordinate` (clamped to [0, 1]) falls on a grid of `samples`
+    points over [0, 1]: the cell k = min(floor(x), N - 2) with x = c (N - 1),
+    and the fraction x - k in [0, 1] across it."""
+    x = chain.clamp("%s (N-1), N = %d" % (name, samples),
+                    chain.math("MULTIPLY", "%s (N-1)" % name, coordinate, samples - 1.0),
+                    0.0, samples - 1.0)
+    cell = chain.math("MINIMUM", "%s cell = min(floor, N-2)" % name,
+                      chain.math("FLOOR", "floor %s (N-1)" % name, x), samples - 2.0)
+    return cell, chain.math("SUBTRACT", "%s fraction" % name, x, cell)
 
-    def at(column, y=0.0):
-        return (FRAME_INSET + COLUMN_STEP * (x + column), y)
 
-    # Pixel centres: u = r (W-1)/W + 1/(2W), clamped into the table.
-    u = math_node(tree, "MULTIPLY_ADD", "u = r (W-1)/W + 1/2W", at(0), frame, "u")
-    u.use_clamp = True
-    links.new(roughness_socket, u.inputs[0])
-    u.inputs[1].default_value = (width - 1.0) / width
-    u.inputs[2].default_value = 0.5 / width
-    v = math_node(tree, "MULTIPLY_ADD", "v = mu (H-1)/H + 1/2H", at(0, -ROW_STEP), frame, "v")
-    v.use_clamp = True
-    links.new(mu_socket, v.inputs[0])
-    v.inputs[1].default_value = (height - 1.0) / height
-    v.inputs[2].default_value = 0.5 / height
+def read_cell(chain, image, column, row, label):
+    """The four corners stored in pixel (column, row) of a corner-packed image
+    (see corner_cells), read at the pixel's centre with Closest interpolation:
+    every engine reads that exactly, whereas EEVEE filters Linear through
+    mipmaps picked by the screen-space derivative of the lookup, which blurs a
+    table read at the view cosine (5 % off at the rim of a 64 px sphere)."""
+    width, height = image.size
+    u = chain.math("MULTIPLY_ADD", "u = (column + 1/2) / W", column, 1.0 / width, 0.5 / width)
+    v = chain.math("MULTIPLY_ADD", "v = (row + 1/2) / H", row, 1.0 / height, 0.5 / height)
+    nodes, links = chain.tree.nodes, chain.tree.links
+    x, y = FRAME_INSET + COLUMN_STEP * (chain.column + 1), chain.y
     uv = nodes.new("ShaderNodeCombineXYZ")
-    uv.name = "uv"
-    set_parent(uv, frame)
-    uv.location = at(1)
-    links.new(u.outputs[0], uv.inputs["X"])
-    links.new(v.outputs[0], uv.inputs["Y"])
+    uv.name = "uv: " + label
+    set_parent(uv, chain.frame)
+    uv.location = (x, y)
+    links.new(u, uv.inputs["X"])
+    links.new(v, uv.inputs["Y"])
     texture = nodes.new("ShaderNodeTexImage")
-    texture.name = "E(mu, r)"
-    texture.label = short_label("E(mu, r) table %d x %d" % (width, height))
-    texture.image = albedo_image(view)
-    texture.interpolation = "Linear"
+    texture.name = label
+    texture.label = short_label("%s, %d x %d cells" % (label, width, height))
+    texture.image = image
+    texture.interpolation = "Closest"
     texture.extension = "EXTEND"
     texture.width = 240.0
-    set_parent(texture, frame)
-    texture.location = at(2)
+    set_parent(texture, chain.frame)
+    texture.location = (x + COLUMN_STEP, y)
     links.new(uv.outputs[0], texture.inputs["Vector"])
-    channels = nodes.new("ShaderNodeSeparateXYZ")
-    channels.name = "E_avg(r)"
-    channels.label = "G = E_avg(r)"
-    set_parent(channels, frame)
-    channels.location = at(3, -ROW_STEP)
-    links.new(texture.outputs["Color"], channels.inputs[0])
-    return texture.outputs["Alpha"], channels.outputs["Y"], x + 4
+    corners = nodes.new("ShaderNodeSeparateXYZ")
+    corners.name = "corners: " + label
+    corners.label = "corners (R, G, B; A)"
+    set_parent(corners, chain.frame)
+    corners.location = (x + 2 * COLUMN_STEP + 100.0, y)
+    links.new(texture.outputs["Color"], corners.inputs[0])
+    chain.skip(4)
+    return (corners.outputs["X"], corners.outputs["Y"], corners.outputs["Z"],
+            texture.outputs["Alpha"])
+
+
+def bilinear(chain, corners, across, up, label):
+    """Bilinear interpolation of a cell's corners (v00, v01, v10, v11) at
+    fractions `across` (second index) and `up` (first index)."""
+    v00, v01, v10, v11 = corners
+    lower = chain.mix_value(label + " lower", across, v00, v01)
+    upper = chain.mix_value(label + " upper", across, v10, v11)
+    return chain.mix_value(label, up, lower, upper)
+
+
+def albedo_lookup(tree, view, roughness_socket, mu_socket, x, frame, average=False):
+    """Nodes that read E(mu, r) (and, if `average`, E_avg(r)) for the clamped
+    roughness and the view cosine; x is the first column. Returns (E, E_avg or
+    None, next column)."""
+    table = view["table"]
+    width, height = int(table["width"]), int(table["height"])
+    image = albedo_image(view)
+    chain = Chain(tree, frame, column=x)
+    column, across = grid_cell(chain, roughness_socket, width, "r")
+    row, up = grid_cell(chain, mu_socket, height, "mu")
+    e = bilinear(chain, read_cell(chain, image, column, row, "E(mu, r)"), across, up, "E(mu, r)")
+    e_avg = None
+    if average:
+        # The top row: E_avg at the cell's two roughness values.
+        low, high, _, _ = read_cell(chain, image, column, height - 1.0, "E_avg(r)")
+        e_avg = chain.mix_value("E_avg(r)", across, low, high)
+    return e, e_avg, chain.column + 1
 
 
 def view_cosine(tree, params, group_in, x, frame):
@@ -185,7 +231,7 @@ def build_view_correction_group(spec, params):
     frame = new_frame(tree, "Albedo frame", "Gain = 1 / E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, params, group_in, 1, frame)
-    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame)
+    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame, average=physical)
     gain = math_node(tree, "DIVIDE", "Gain = 1 / E", (FRAME_INSET + COLUMN_STEP * column + 100.0, 0.0),
                      frame, "Gain")
     gain.inputs[0].default_value = 1.0
@@ -257,7 +303,7 @@ def build_multiscatter_group(spec, params):
     frame = new_frame(tree, "Albedo frame", "Lost energy 1 - E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, params, group_in, 1, frame)
-    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame)
+    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame, average=physical)
     x = FRAME_INSET + COLUMN_STEP * column + 100.0
     lost = math_node(tree, "SUBTRACT", "1 - E", (x, 0.0), frame, "Lost")
     lost.inputs[0].default_value = 1.0

@@ -115,7 +115,7 @@ fn main() {
 }
 
 /// The atlas as `generate` packs it (`coat::SLICES` slices, `ATLAS` × `ATLAS` per slice,
-/// grid points at i/(n − 1)), read as Blender reads it: bilinear in (r, μ), linear between
+/// grid points at i/(n − 1)), read as the layered group reads it: bilinear in (r, μ), linear between
 /// slices in z = F0^¼. Worst |ΔA| at 2000 pseudo-random (μ, r, η), μ ≥ 0.05.
 fn atlas_as_packed() {
     use gloffuse::measure::coat::{SLICES, slice_coordinate};

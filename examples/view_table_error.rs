@@ -1,5 +1,5 @@
 //! How finely the E(μ, r) image must sample for `--mode view`: the worst relative error of
-//! bilinear interpolation (what Cycles' Linear image sampling does) at cell midpoints, for
+//! bilinear interpolation (what the groups compute from the cell's corners) at cell midpoints, for
 //! μ ≥ 0.05 (a sphere's rim pixels below that are a sliver). Run:
 //! `cargo run --release --example view_table_error`
 

@@ -791,6 +791,11 @@ class Chain:
             self._row = 0
             self.column += 1
 
+    def skip(self, columns):
+        """Leave `columns` columns to other nodes; go on at the top of the next."""
+        self.column += columns + (1 if self._row else 0)
+        self._row = 0
+
     def _feed(self, socket, value):
         if isinstance(value, bpy.types.NodeSocket):
             self.tree.links.new(value, socket)
@@ -829,10 +834,20 @@ class Chain:
         step = self.vector("SCALE", label + ": scaled", difference, flag)
         return self.vector("ADD", label, when_zero, step)
 
-    def select_value(self, label, flag, when_zero, when_one):
-        """when_zero + flag (when_one - when_zero) for floats; flag is 0 or 1."""
-        difference = self.math("SUBTRACT", label + ": difference", when_one, when_zero)
-        return self.math("MULTIPLY_ADD", label, difference, flag, when_zero)
+    def mix_value(self, label, t, at_zero, at_one):
+        """at_zero + t (at_one - at_zero) for floats: a 0/1 flag selects, a
+        fraction interpolates linearly."""
+        difference = self.math("SUBTRACT", label + ": difference", at_one, at_zero)
+        return self.math("MULTIPLY_ADD", label, difference, t, at_zero)
+
+    def clamp(self, label, value, low, high):
+        """A Clamp node: value clamped to [low, high]."""
+        node = self.tree.nodes.new("ShaderNodeClamp")
+        node.clamp_type = "MINMAX"
+        for socket, operand in zip(node.inputs, (value, low, high)):
+            self._feed(socket, operand)
+        self._place(node, label, None)
+        return node.outputs[0]
 
 
 def asset_fields(params, kind):
@@ -1185,13 +1200,13 @@ def _raised_normal_3_0(chain, I, Ng, X, Ix, Iz, t, a, minus_iz):
     both_up = chain.math("MULTIPLY", "R1, R2 ≥ 1e-5",
                          chain.math("SUBTRACT", "R1 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R1 < 1e-5", r1, 1e-5)),
                          chain.math("SUBTRACT", "R2 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R2 < 1e-5", r2, 1e-5)))
-    first_if_both = chain.select_value("pick 1 of two", both_up,
-                                       chain.math("GREATER_THAN", "R1 > R2", r1, r2),
-                                       chain.math("LESS_THAN", "R1 < R2", r1, r2))
+    first_if_both = chain.mix_value("pick 1 of two", both_up,
+                                    chain.math("GREATER_THAN", "R1 > R2", r1, r2),
+                                    chain.math("LESS_THAN", "R1 < R2", r1, r2))
     both = chain.math("MULTIPLY", "both valid", v1, v2)
-    first = chain.select_value("pick 1", both, v1, first_if_both)
-    nx = chain.select_value("N'x", first, x2, x1)
-    nz = chain.select_value("N'z", first, z2, z1)
+    first = chain.mix_value("pick 1", both, v1, first_if_both)
+    nx = chain.mix_value("N'x", first, x2, x1)
+    nz = chain.mix_value("N'z", first, z2, z1)
     raised = chain.vector("ADD", "N' = N'x X + N'z Ng",
                           chain.vector("SCALE", "N'x X", X, nx),
                           chain.vector("SCALE", "N'z Ng", Ng, nz))
@@ -1279,11 +1294,12 @@ def normal_group_node(tree, normal_tree, group_in, location, frame=None):
 # group, and the multiscatter group Glossy + Diffuse(Color x (1 - E(mu, r))).
 #
 # The directional albedo E(mu, r) travels as a table in the parameters and is
-# packed into the .blend as a 32-bit float OpenEXR image (R = B = A = E, G =
-# E_avg(r)). An Image Texture node samples it at (u, v) = pixel centres of
-# (r, mu), with mu the view cosine at the normal the BSDF really uses (the
-# normal group of normal_group.py), so Cycles' linear interpolation
-# reproduces the table exactly at its grid points.
+# packed into the .blend as a 32-bit float OpenEXR image, one pixel per cell of
+# the table holding the cell's four corners, plus a row for E_avg(r). The group
+# reads the cell (r, mu) falls in with Closest interpolation and interpolates
+# bilinearly in Math nodes, with mu the view cosine at the normal the BSDF
+# really uses (the normal group of normal_group.py): Cycles and EEVEE read the
+# same numbers, the table's own at its grid points.
 #
 # Colour (params["color_model"]): "exact" multiplies Color by 1 / E, so the
 # surface's albedo is Color; "physical" tints the energy multiple bounces add
@@ -1315,11 +1331,25 @@ def view_shader_sockets(output_description):
     ]
 
 
+def corner_cells(value_at, rows, columns):
+    """RGBA pixels (bottom row first) of a table of rows x columns samples
+    packed by cell: pixel (i, j) of the (columns - 1) x (rows - 1) image holds
+    the corners of cell (i, j), (v[i][j], v[i][j+1], v[i+1][j], v[i+1][j+1]),
+    so one unfiltered read gives everything its bilinear interpolation needs."""
+    pixels = []
+    for i in range(rows - 1):
+        for j in range(columns - 1):
+            pixels.extend((value_at(i, j), value_at(i, j + 1),
+                           value_at(i + 1, j), value_at(i + 1, j + 1)))
+    return pixels
+
+
 def albedo_image(view):
     """The packed float image holding E(mu, r): reused by name, resized if needed.
-    Row i is mu = i / (height - 1) (row 0 at the bottom, Blender's order), column
-    j is r = j / (width - 1); E is stored in R, B and alpha, E_avg(r) in G
-    (channel packed)."""
+    Row i < height - 1 holds the cells between mu = i / (height - 1) and
+    (i + 1) / (height - 1) (see corner_cells), column j those between
+    r = j / (width - 1) and (j + 1) / (width - 1); the top row holds E_avg(r)
+    the same way: (E_avg(r_j), E_avg(r_j+1), E_avg(r_j), E_avg(r_j+1))."""
     table = view["table"]
     width, height = int(table["width"]), int(table["height"])
     values = finite_list(table["values"], "view.table.values")
@@ -1328,10 +1358,9 @@ def albedo_image(view):
     average = finite_list(table["average"], "view.table.average")
     if len(average) != width:
         raise ValueError("view.table.average holds %d values, not %d" % (len(average), width))
-    pixels = []
-    for index, value in enumerate(values):
-        pixels.extend((value, average[index % width], value, value))
-    return packed_float_image(view["image"], width, height, pixels)
+    pixels = corner_cells(lambda i, j: values[i * width + j], height, width)
+    pixels += corner_cells(lambda i, j: average[j], 2, width)
+    return packed_float_image(view["image"], width - 1, height, pixels)
 
 
 def packed_float_image(name, width, height, pixels):
@@ -1352,50 +1381,82 @@ def packed_float_image(name, width, height, pixels):
     return image
 
 
-def albedo_lookup(tree, view, roughness_socket, mu_socket, x, frame):
-    """Nodes that read E(mu, r) and E_avg(r) for the clamped roughness and the
-    view cosine; x is the first column. Returns (E, E_avg, next column)."""
-    nodes, links = tree.nodes, tree.links
-    table = view["table"]
-    width, height = int(table["width"]), int(table["height"])
+def grid_cell(chain, coordinate, samples, name):
+    """Where `coordinate` (clamped to [0, 1]) falls on a grid of `samples`
+    points over [0, 1]: the cell k = min(floor(x), N - 2) with x = c (N - 1),
+    and the fraction x - k in [0, 1] across it."""
+    x = chain.clamp("%s (N-1), N = %d" % (name, samples),
+                    chain.math("MULTIPLY", "%s (N-1)" % name, coordinate, samples - 1.0),
+                    0.0, samples - 1.0)
+    cell = chain.math("MINIMUM", "%s cell = min(floor, N-2)" % name,
+                      chain.math("FLOOR", "floor %s (N-1)" % name, x), samples - 2.0)
+    return cell, chain.math("SUBTRACT", "%s fraction" % name, x, cell)
 
-    def at(column, y=0.0):
-        return (FRAME_INSET + COLUMN_STEP * (x + column), y)
 
-    # Pixel centres: u = r (W-1)/W + 1/(2W), clamped into the table.
-    u = math_node(tree, "MULTIPLY_ADD", "u = r (W-1)/W + 1/2W", at(0), frame, "u")
-    u.use_clamp = True
-    links.new(roughness_socket, u.inputs[0])
-    u.inputs[1].default_value = (width - 1.0) / width
-    u.inputs[2].default_value = 0.5 / width
-    v = math_node(tree, "MULTIPLY_ADD", "v = mu (H-1)/H + 1/2H", at(0, -ROW_STEP), frame, "v")
-    v.use_clamp = True
-    links.new(mu_socket, v.inputs[0])
-    v.inputs[1].default_value = (height - 1.0) / height
-    v.inputs[2].default_value = 0.5 / height
+def read_cell(chain, image, column, row, label):
+    """The four corners stored in pixel (column, row) of a corner-packed image
+    (see corner_cells), read at the pixel's centre with Closest interpolation:
+    every engine reads that exactly, whereas EEVEE filters Linear through
+    mipmaps picked by the screen-space derivative of the lookup, which blurs a
+    table read at the view cosine (5 % off at the rim of a 64 px sphere)."""
+    width, height = image.size
+    u = chain.math("MULTIPLY_ADD", "u = (column + 1/2) / W", column, 1.0 / width, 0.5 / width)
+    v = chain.math("MULTIPLY_ADD", "v = (row + 1/2) / H", row, 1.0 / height, 0.5 / height)
+    nodes, links = chain.tree.nodes, chain.tree.links
+    x, y = FRAME_INSET + COLUMN_STEP * (chain.column + 1), chain.y
     uv = nodes.new("ShaderNodeCombineXYZ")
-    uv.name = "uv"
-    set_parent(uv, frame)
-    uv.location = at(1)
-    links.new(u.outputs[0], uv.inputs["X"])
-    links.new(v.outputs[0], uv.inputs["Y"])
+    uv.name = "uv: " + label
+    set_parent(uv, chain.frame)
+    uv.location = (x, y)
+    links.new(u, uv.inputs["X"])
+    links.new(v, uv.inputs["Y"])
     texture = nodes.new("ShaderNodeTexImage")
-    texture.name = "E(mu, r)"
-    texture.label = short_label("E(mu, r) table %d x %d" % (width, height))
-    texture.image = albedo_image(view)
-    texture.interpolation = "Linear"
+    texture.name = label
+    texture.label = short_label("%s, %d x %d cells" % (label, width, height))
+    texture.image = image
+    texture.interpolation = "Closest"
     texture.extension = "EXTEND"
     texture.width = 240.0
-    set_parent(texture, frame)
-    texture.location = at(2)
+    set_parent(texture, chain.frame)
+    texture.location = (x + COLUMN_STEP, y)
     links.new(uv.outputs[0], texture.inputs["Vector"])
-    channels = nodes.new("ShaderNodeSeparateXYZ")
-    channels.name = "E_avg(r)"
-    channels.label = "G = E_avg(r)"
-    set_parent(channels, frame)
-    channels.location = at(3, -ROW_STEP)
-    links.new(texture.outputs["Color"], channels.inputs[0])
-    return texture.outputs["Alpha"], channels.outputs["Y"], x + 4
+    corners = nodes.new("ShaderNodeSeparateXYZ")
+    corners.name = "corners: " + label
+    corners.label = "corners (R, G, B; A)"
+    set_parent(corners, chain.frame)
+    corners.location = (x + 2 * COLUMN_STEP + 100.0, y)
+    links.new(texture.outputs["Color"], corners.inputs[0])
+    chain.skip(4)
+    return (corners.outputs["X"], corners.outputs["Y"], corners.outputs["Z"],
+            texture.outputs["Alpha"])
+
+
+def bilinear(chain, corners, across, up, label):
+    """Bilinear interpolation of a cell's corners (v00, v01, v10, v11) at
+    fractions `across` (second index) and `up` (first index)."""
+    v00, v01, v10, v11 = corners
+    lower = chain.mix_value(label + " lower", across, v00, v01)
+    upper = chain.mix_value(label + " upper", across, v10, v11)
+    return chain.mix_value(label, up, lower, upper)
+
+
+def albedo_lookup(tree, view, roughness_socket, mu_socket, x, frame, average=False):
+    """Nodes that read E(mu, r) (and, if `average`, E_avg(r)) for the clamped
+    roughness and the view cosine; x is the first column. Returns (E, E_avg or
+    None, next column)."""
+    table = view["table"]
+    width, height = int(table["width"]), int(table["height"])
+    image = albedo_image(view)
+    chain = Chain(tree, frame, column=x)
+    column, across = grid_cell(chain, roughness_socket, width, "r")
+    row, up = grid_cell(chain, mu_socket, height, "mu")
+    e = bilinear(chain, read_cell(chain, image, column, row, "E(mu, r)"), across, up, "E(mu, r)")
+    e_avg = None
+    if average:
+        # The top row: E_avg at the cell's two roughness values.
+        low, high, _, _ = read_cell(chain, image, column, height - 1.0, "E_avg(r)")
+        e_avg = chain.mix_value("E_avg(r)", across, low, high)
+    return e, e_avg, chain.column + 1
 
 
 def view_cosine(tree, params, group_in, x, frame):
@@ -1460,7 +1521,7 @@ def build_view_correction_group(spec, params):
     frame = new_frame(tree, "Albedo frame", "Gain = 1 / E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, params, group_in, 1, frame)
-    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame)
+    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame, average=physical)
     gain = math_node(tree, "DIVIDE", "Gain = 1 / E", (FRAME_INSET + COLUMN_STEP * column + 100.0, 0.0),
                      frame, "Gain")
     gain.inputs[0].default_value = 1.0
@@ -1532,7 +1593,7 @@ def build_multiscatter_group(spec, params):
     frame = new_frame(tree, "Albedo frame", "Lost energy 1 - E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, params, group_in, 1, frame)
-    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame)
+    albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame, average=physical)
     x = FRAME_INSET + COLUMN_STEP * column + 100.0
     lost = math_node(tree, "SUBTRACT", "1 - E", (x, 0.0), frame, "Lost")
     lost.inputs[0].default_value = 1.0
@@ -1582,12 +1643,12 @@ def build_multiscatter_group(spec, params):
 #
 # A travels as one packed float image: slices side by side, slice k for the
 # index whose z = F0^(1/4) is k z_max / (K - 1), each slice a grid over (r, mu)
-# read at pixel centres; the group reads the two slices around its IOR and
-# mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
+# packed by cell as the E(mu, r) image is; the group reads the cell in the two
+# slices around its IOR and mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
 # from the shading-normal group (normal_group.py).
 #
 # One part of the script the gloffuse binary concatenates, after
-# view_groups.py (whose albedo_lookup it uses). Functions and constants only.
+# view_groups.py (whose albedo_lookup, grid_cell, read_cell and bilinear it uses). Functions and constants only.
 # ---------------------------------------------------------------------------
 
 LAYERED_IOR_MIN = 1.0
@@ -1615,71 +1676,53 @@ def layered_sockets():
 
 
 def coat_image(layered):
-    """The packed float image of A(mu, r, IOR).
-    Row i is mu = i / (size - 1) (bottom row first); slice k fills columns
-    k size .. (k + 1) size - 1, column j of it r = j / (size - 1). A is stored in
-    every channel."""
+    """The packed float image of A(mu, r, IOR), slice by slice side by side:
+    slice k packed by cell (see corner_cells in view_groups.py) fills columns
+    k (size - 1) .. (k + 1) (size - 1) - 1, row i the cells between
+    mu = i / (size - 1) and (i + 1) / (size - 1)."""
     table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
-    width = size * slices
     values = finite_list(table["values"], "layered.coat_table.values")
-    if len(values) != width * size:
+    if len(values) != size * slices * size:
         raise ValueError("layered.coat_table holds %d values, not %d x %d"
-                         % (len(values), width, size))
+                         % (len(values), size * slices, size))
+    cells = size - 1
+    packed = [corner_cells(lambda i, j, k=k: values[(i * slices + k) * size + j], size, size)
+              for k in range(slices)]
     pixels = []
-    for value in values:
-        pixels.extend((value, value, value, value))
-    return packed_float_image(layered["coat_image"], width, size, pixels)  # view_groups.py
+    for i in range(cells):
+        for slice_pixels in packed:
+            pixels.extend(slice_pixels[4 * cells * i:4 * cells * (i + 1)])
+    return packed_float_image(layered["coat_image"], cells * slices, cells, pixels)
 
 
-def coat_lookup(tree, layered, chain, roughness, mu, ior, x, frame):
-    """Nodes that read A(mu, r, IOR): the two slices around the index, mixed
-    linearly in z = F0^(1/4). Returns the A socket."""
+def coat_lookup(tree, layered, chain, roughness, mu, ior, frame):
+    """Nodes that read A(mu, r, IOR): the two slices around the index, each
+    interpolated bilinearly in (r, mu), mixed linearly in z = F0^(1/4).
+    Returns the A socket."""
     table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4), for n clamped to the table's range.
-    n = chain.math("MINIMUM", "n = min(IOR, %g)" % LAYERED_IOR_MAX,
-                   chain.math("MAXIMUM", "max(IOR, 1)", ior, LAYERED_IOR_MIN), LAYERED_IOR_MAX)
+    n = chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, LAYERED_IOR_MAX), ior,
+                    LAYERED_IOR_MIN, LAYERED_IOR_MAX)
     ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
                        chain.math("ADD", "n + 1", n, 1.0))
     z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
     s = chain.math("MULTIPLY", "slice position z (K-1) / z_max", z, (slices - 1) / z_max)
-    k0 = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
-                    slices - 2.0)
-    t = chain.math("SUBTRACT", "t = position - k", s, k0)
-    # Pixel centres of slice k: u = (k W + 1/2 + r (W - 1)) / (K W); the next slice is 1/K on.
-    within = chain.math("MULTIPLY_ADD", "r (W-1) + 1/2", roughness, size - 1.0, 0.5)
-    u0 = chain.math("DIVIDE", "u of slice k",
-                    chain.math("MULTIPLY_ADD", "k W + r (W-1) + 1/2", k0, float(size), within),
-                    float(size * slices))
-    u1 = chain.math("ADD", "u of slice k + 1", u0, 1.0 / slices)
-    v = chain.math("MULTIPLY_ADD", "v = mu (H-1)/H + 1/2H", mu, (size - 1.0) / size, 0.5 / size)
+    k = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
+                   slices - 2.0)
+    t = chain.math("SUBTRACT", "t = position - k", s, k)
+    column, across = grid_cell(chain, roughness, size, "r")  # view_groups.py
+    row, up = grid_cell(chain, mu, size, "mu")
     image = coat_image(layered)
-    samples = []
-    for index, u in enumerate((u0, u1)):
-        uv = tree.nodes.new("ShaderNodeCombineXYZ")
-        uv.name = "uv %d" % index
-        set_parent(uv, frame)
-        uv.location = (FRAME_INSET + COLUMN_STEP * x, -ROW_STEP * (4 + 2 * index))
-        tree.links.new(u, uv.inputs["X"])
-        tree.links.new(v, uv.inputs["Y"])
-        texture = tree.nodes.new("ShaderNodeTexImage")
-        texture.name = "A(mu, r) slice %s" % ("k", "k + 1")[index]
-        texture.label = short_label("coat A(mu, r, IOR) %d x %d x %d, slice %s"
-                                    % (size, size, slices, ("k", "k + 1")[index]))
-        texture.image = image
-        texture.interpolation = "Linear"
-        texture.extension = "EXTEND"
-        texture.width = 240.0
-        set_parent(texture, frame)
-        texture.location = (FRAME_INSET + COLUMN_STEP * (x + 1), -ROW_STEP * (4 + 2 * index))
-        tree.links.new(uv.outputs[0], texture.inputs["Vector"])
-        samples.append(texture.outputs["Alpha"])
-    chain.column = max(chain.column, x + 3)
-    difference = chain.math("SUBTRACT", "A(k + 1) - A(k)", samples[1], samples[0])
-    return chain.math("MULTIPLY_ADD", "A = A(k) + t (A(k + 1) - A(k))", difference, t, samples[0],
-                      name="Coat albedo")
+    # Slice k's cells start at column k (size - 1); slice k + 1's one slice on.
+    first = chain.math("MULTIPLY_ADD", "column in slice k", k, size - 1.0, column)
+    second = chain.math("ADD", "column in slice k + 1", first, size - 1.0)
+    a = [bilinear(chain, read_cell(chain, image, c, row, "A(mu, r) slice " + name), across, up,
+                  "A slice " + name)
+         for c, name in ((first, "k"), (second, "k + 1"))]
+    return chain.mix_value("A = A(k) + t (A(k + 1) - A(k))", t, a[0], a[1])
 
 
 def build_layered_group(spec, params):
@@ -1695,9 +1738,9 @@ def build_layered_group(spec, params):
                       "Coat albedo A(mu, r, IOR) and E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, params, group_in, 1, frame)
-    albedo, _e_avg, column = albedo_lookup(tree, layered, r, mu, 2, frame)
+    albedo, _, column = albedo_lookup(tree, layered, r, mu, 2, frame)
     chain = Chain(tree, frame, column=column, y=0.0)
-    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], column, frame)
+    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], frame)
     weight = chain.math("DIVIDE", "A / E", a, albedo, name="Coat weight")
     glossy_color = chain.vector("SCALE", "Specular Tint × A / E", group_in.outputs["Specular Tint"],
                                 weight, name="Coat colour")
