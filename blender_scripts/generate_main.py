@@ -40,7 +40,7 @@ def generate_main():
     built = build_all(params)  # noqa: F821 -- groups.py
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
-            render_previews(built, params, directory)  # noqa: F821 -- previews.py
+            render_previews(built, directory)  # noqa: F821 -- previews.py
     saved = save_blend(options.save) if options.save else None  # noqa: F821 -- runtime.py
     names = []
     for _spec, trees in built:

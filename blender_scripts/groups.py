@@ -14,19 +14,22 @@ def build_all(params):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
-    with spec["layered"] the layered group, after the shared normal group they use. Returns [(spec, [trees...]), ...] in
-    document order; the normal group comes first with the first view spec."""
+    with spec["layered"] the layered group, after the normal group they use
+    (spec["normal_group"], shared by the specs of one engine). Returns
+    [(spec, [trees...]), ...] in document order; a normal group comes first
+    with the first spec that uses it."""
     validate_params(params)
     built = []
-    normal_tree = None
+    normal_names = set()
     for spec in params["groups"]:
         correction = build_correction_group(spec, params)
         trees = [correction, build_shader_group(spec, params, correction)]
+        normal = spec.get("normal_group")
+        if normal is not None and normal not in normal_names:
+            normal_names.add(normal)
+            trees.insert(0, build_normal_group(spec, params))
         view = spec.get("view")
         if view:
-            if normal_tree is None:
-                normal_tree = build_normal_group(params)
-                trees.insert(0, normal_tree)
             if view.get("correction_group"):
                 view_correction = build_view_correction_group(spec, params)
                 trees.append(view_correction)
@@ -34,9 +37,6 @@ def build_all(params):
             if view.get("multiscatter_group"):
                 trees.append(build_multiscatter_group(spec, params))
         if spec.get("layered"):
-            if normal_tree is None:
-                normal_tree = build_normal_group(params)
-                trees.insert(0, normal_tree)
             trees.append(build_layered_group(spec, params))
         built.append((spec, trees))
     return built

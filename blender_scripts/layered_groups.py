@@ -24,7 +24,7 @@ LAYERED_IOR_MIN = 1.0
 LAYERED_IOR_MAX = 3.0
 
 
-def layered_sockets():
+def layered_sockets(spec):
     """Base Color, Roughness, IOR, Specular Tint, Normal [, Bump Map Correction] -> BSDF."""
     return [
         {"in_out": "INPUT", "name": "Base Color", "type": "NodeSocketColor",
@@ -38,7 +38,7 @@ def layered_sockets():
          "default": (1.0, 1.0, 1.0, 1.0),
          "description": "Tint of the coat's reflection (the base still gets 1 - A)"},
         NORMAL_INPUT,
-    ] + bump_map_correction_inputs() + [
+    ] + bump_map_correction_inputs(spec) + [
         {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
          "description": "Glossy coat plus diffuse base; a white base reflects everything"},
     ]
@@ -99,14 +99,14 @@ def build_layered_group(spec, params):
     Tint x A / E) + Diffuse(Base Color x (1 - A))."""
     layered = spec["layered"]
     tree = reuse_or_create_group(layered["shader_group"])
-    ensure_interface(tree, layered_sockets())
+    ensure_interface(tree, layered_sockets(spec))
     nodes = tree.nodes
     group_in = nodes.new("NodeGroupInput")
     group_in.location = (0.0, 0.0)
     frame = new_frame(tree, "Coat frame",
                       "Coat albedo A(mu, r, IOR) and E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
-    mu = view_cosine(tree, params, group_in, 1, frame)
+    mu = view_cosine(tree, spec, group_in, 1, frame)
     albedo, _, column = albedo_lookup(tree, layered, r, mu, 2, frame)
     chain = Chain(tree, frame, column=column, y=0.0)
     a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], frame)
@@ -126,7 +126,7 @@ def build_layered_group(spec, params):
         "Multiscatter GGX), read from the packed table '%s'; the base gets Base Color x "
         "(1 - A). A white base reflects 100 %% at every roughness, view and IOR. mu is read "
         "at the normal the glossy BSDF shades with (see '%s')."
-        % (spec["distribution"], layered["coat_image"], params["normal_group"])))
+        % (spec["distribution"], layered["coat_image"], spec["normal_group"])))
     set_tree_description(tree, description)
     mark_asset(tree, description, ["gloffuse", spec["distribution"], "layered"],
                asset_fields(params, "shader"))

@@ -1,6 +1,7 @@
 # ---------------------------------------------------------------------------
 # gloffuse normal_group.py: the helper group every view-dependent group uses
-# to find the normal a glossy BSDF really shades with, and its view cosine.
+# to find the normal a glossy BSDF really shades with, and its view cosine;
+# one for Cycles' groups, one for EEVEE's (spec["normal_group"]).
 #
 # Cycles never hands a bump or normal-map normal straight to a glossy lobe: if
 # the mirror reflection about N would dip below the true surface, it first
@@ -10,7 +11,8 @@
 # valid_reflection_rule): 3.0-3.5's ensure_valid_reflection (two candidate
 # roots, checked) or 3.6+'s ensure_valid_specular_reflection (one closed-form
 # root), and from 4.1 it honours the material's Bump Map Correction through an
-# input of the same name.
+# input of the same name. EEVEE raises nothing: its group passes the normal
+# on and clamps the view cosine to [0, 1], as EEVEE reads its table.
 #
 # One part of the script the gloffuse binary concatenates: header, compat.py,
 # params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
@@ -29,15 +31,24 @@ BUMP_MAP_CORRECTION_INPUT = {
                    "set 0 where it is off"}
 
 
-def bump_map_correction_inputs():
-    """The Bump Map Correction input, in the Blenders that have the setting."""
-    return [BUMP_MAP_CORRECTION_INPUT] if has_bump_map_correction() else []
+def is_eevee(spec):
+    """Are the spec's groups calibrated for EEVEE (which shades with a bump
+    normal as it is) rather than Cycles (which raises it)?"""
+    return spec.get("engine", "cycles") == "eevee"
 
 
-def normal_group_sockets():
-    return [NORMAL_INPUT] + bump_map_correction_inputs() + [
+def bump_map_correction_inputs(spec):
+    """The Bump Map Correction input, for Cycles' groups in the Blenders that
+    have the setting (it switches Cycles' raising of the normal off; EEVEE
+    never raises it)."""
+    return [BUMP_MAP_CORRECTION_INPUT] if has_bump_map_correction() and not is_eevee(spec) else []
+
+
+def normal_group_sockets(spec):
+    return [NORMAL_INPUT] + bump_map_correction_inputs(spec) + [
         {"in_out": "OUTPUT", "name": "Normal", "type": "NodeSocketVector",
-         "description": "The normal Cycles' glossy BSDF shades with"},
+         "description": "The normal %s glossy BSDF shades with"
+                        % ("EEVEE's" if is_eevee(spec) else "Cycles'")},
         {"in_out": "OUTPUT", "name": "View Cosine", "type": "NodeSocketFloat",
          "description": "mu = N' · I, the view cosine at that normal"},
     ]
@@ -104,27 +115,68 @@ def _raised_normal_3_0(chain, I, Ng, X, Ix, Iz, t, a, minus_iz):
     return chain.select("N' or Ng", chain.math("MAXIMUM", "any valid", v1, v2), Ng, raised)
 
 
-def build_normal_group(params):
-    """Normal [, Bump Map Correction] -> Normal, View Cosine: the normal
-    Cycles' glossy BSDF shades with, and mu = N' · I."""
-    tree = reuse_or_create_group(params["normal_group"])
-    ensure_interface(tree, normal_group_sockets())
-    nodes, links = tree.nodes, tree.links
-    group_in = nodes.new("NodeGroupInput")
+def build_normal_group(spec, params):
+    """The spec's normal group: Cycles' (the raised normal) or EEVEE's (the
+    normal as given)."""
+    if is_eevee(spec):
+        return _build_eevee_normal_group(spec, params)
+    return _build_cycles_normal_group(spec, params)
+
+
+def _normal_frame(spec, label):
+    """The normal group's tree, Group Input, frame, Geometry node and a Chain
+    after it, with N = the Normal input normalised (unconnected, it arrives as
+    (0, 0, 0): the surface's own normal)."""
+    tree = reuse_or_create_group(spec["normal_group"])
+    ensure_interface(tree, normal_group_sockets(spec))
+    group_in = tree.nodes.new("NodeGroupInput")
     group_in.location = (0.0, 0.0)
-    rule = valid_reflection_rule()
-    frame = new_frame(tree, "Normal frame", short_label(
-        "N raised until its mirror reflection clears the surface (Cycles %s rule)" % rule))
-    geometry = nodes.new("ShaderNodeNewGeometry")
+    frame = new_frame(tree, "Normal frame", short_label(label))
+    geometry = tree.nodes.new("ShaderNodeNewGeometry")
     geometry.name = "Geometry"
     set_parent(geometry, frame)
     geometry.location = (FRAME_INSET, -ROW_STEP)
     chain = Chain(tree, frame, column=1)
-    I, Ng = geometry.outputs["Incoming"], geometry.outputs["True Normal"]
-    # An unconnected Normal input arrives as (0, 0, 0): use the surface's normal.
     given = group_in.outputs["Normal"]
     connected = chain.math("GREATER_THAN", "Normal connected", chain.vector("LENGTH", "|Normal|", given), 0.5)
     N = chain.select("N", connected, geometry.outputs["Normal"], chain.vector("NORMALIZE", "Normal / |Normal|", given))
+    return tree, group_in, geometry, chain, N
+
+
+def _finish_normal_group(tree, chain, params, used, mu, description):
+    group_out = tree.nodes.new("NodeGroupOutput")
+    group_out.location = (FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 100.0, 0.0)
+    tree.links.new(used, group_out.inputs["Normal"])
+    tree.links.new(mu, group_out.inputs["View Cosine"])
+    description += " Used by gloffuse's view-dependent groups. Generated by gloffuse %s in Blender %s." % (
+        params.get("gloffuse_version", "?"), blender_version_string())
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", "normal"], asset_fields(params, "helper"))
+    return tree
+
+
+def _build_eevee_normal_group(spec, params):
+    """Normal -> Normal, View Cosine: EEVEE shades a glossy lobe with the bump
+    or normal-map normal as it is, and reads its split-sum table at N · I
+    clamped to [0, 1] (measured: a strongly bumped sphere renders E(max(N · I,
+    0)) pixel by pixel in 4.5 and 5.0, and in 3.4 wherever N · I >= 0)."""
+    tree, group_in, geometry, chain, N = _normal_frame(
+        spec, "EEVEE: N as given, mu = clamp(N · I, 0, 1)")
+    mu = chain.clamp("View Cosine = clamp(N · I, 0, 1)",
+                     chain.vector("DOT_PRODUCT", "N · I", N, geometry.outputs["Incoming"]), 0.0, 1.0)
+    return _finish_normal_group(tree, chain, params, N, mu, (
+        "The normal EEVEE's glossy BSDF shades with: a bump or normal-map normal as it is "
+        "(or, unconnected, the surface's own), and the view cosine there, clamped to [0, 1] "
+        "as EEVEE clamps it."))
+
+
+def _build_cycles_normal_group(spec, params):
+    """Normal [, Bump Map Correction] -> Normal, View Cosine: the normal
+    Cycles' glossy BSDF shades with, and mu = N' · I."""
+    rule = valid_reflection_rule()
+    tree, group_in, geometry, chain, N = _normal_frame(
+        spec, "N raised until its mirror reflection clears the surface (Cycles %s rule)" % rule)
+    I, Ng = geometry.outputs["Incoming"], geometry.outputs["True Normal"]
     n_dot_ng = chain.vector("DOT_PRODUCT", "N · Ng", N, Ng)
     iz = chain.vector("DOT_PRODUCT", "Iz = I · Ng", I, Ng)
     minus_iz = chain.math("MULTIPLY", "−Iz", iz, -1.0)
@@ -146,20 +198,11 @@ def build_normal_group(params):
         raised = _raised_normal_3_0(chain, I, Ng, X, ix, iz, t, a, minus_iz)
     used = chain.select("Normal used", needed, N, raised)
     mu = chain.vector("DOT_PRODUCT", "View Cosine = N' · I", used, I)
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 100.0, 0.0)
-    links.new(used, group_out.inputs["Normal"])
-    links.new(mu, group_out.inputs["View Cosine"])
-    description = (
+    return _finish_normal_group(tree, chain, params, used, mu, (
         "The normal Cycles' glossy BSDF really shades with: a bump or normal-map normal "
         "(or, unconnected, the surface's own) raised towards the true normal wherever its "
         "mirror reflection would dip below the surface (Blender %s's rule%s), and the view "
-        "cosine at it. Used by gloffuse's view-dependent groups. Generated by gloffuse %s in "
-        "Blender %s." % (rule, ", honouring Bump Map Correction" if has_bump_map_correction() else "",
-                         params.get("gloffuse_version", "?"), blender_version_string()))
-    set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", "normal"], asset_fields(params, "helper"))
-    return tree
+        "cosine at it." % (rule, ", honouring Bump Map Correction" if has_bump_map_correction() else "")))
 
 
 def normal_group_node(tree, normal_tree, group_in, location, frame=None):
@@ -173,7 +216,7 @@ def normal_group_node(tree, normal_tree, group_in, location, frame=None):
     if frame is not None:
         set_parent(node, frame)
     node.location = location
-    tree.links.new(group_in.outputs["Normal"], node.inputs["Normal"])
-    if has_bump_map_correction():
-        tree.links.new(group_in.outputs["Bump Map Correction"], node.inputs["Bump Map Correction"])
+    for name in ("Normal", "Bump Map Correction"):
+        if name in node.inputs:
+            tree.links.new(group_in.outputs[name], node.inputs[name])
     return node

@@ -20,6 +20,7 @@ DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
 CURVE_VARIABLES = ("roughness", "alpha")
 MASKINGS = ("separable", "height-correlated")
 COLOR_MODELS = ("exact", "physical")
+ENGINES = ("cycles", "eevee")
 VIEW_GROUPS = ("correction_group", "shader_group", "multiscatter_group")
 
 
@@ -116,7 +117,7 @@ def validate_params(params):
         raise ValueError("the parameter document needs a non-empty 'groups' list")
     limit = max_name_bytes()
     seen = set()
-    views = False
+    normals = set()
     for index, spec in enumerate(groups):
         where = "groups[%d]" % index
         if not isinstance(spec, dict):
@@ -126,9 +127,16 @@ def validate_params(params):
                              % (where, spec.get("distribution"), ", ".join(DISTRIBUTIONS)))
         for key in ("correction_group", "shader_group"):
             _name(spec.get(key), "%s.%s" % (where, key), limit, seen)
+        if spec.get("engine", "cycles") not in ENGINES:
+            raise ValueError("%s.engine is %r; expected one of %s"
+                             % (where, spec.get("engine"), ", ".join(ENGINES)))
         view = spec.get("view")
+        if (view is not None or spec.get("layered") is not None) \
+                and spec.get("normal_group") not in normals:
+            # One normal group serves every spec of an engine.
+            _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
+            normals.add(spec["normal_group"])
         if view is not None:
-            views = True
             if not isinstance(view, dict):
                 raise ValueError("%s.view must be an object" % where)
             present = [key for key in VIEW_GROUPS if view.get(key) is not None]
@@ -143,7 +151,6 @@ def validate_params(params):
                 raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
         layered = spec.get("layered")
         if layered is not None:
-            views = True
             if not isinstance(layered, dict):
                 raise ValueError("%s.layered must be an object" % where)
             _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
@@ -167,8 +174,6 @@ def validate_params(params):
             coeffs = finite_list(curve.get(key), "%s.curve.%s" % (where, key))
             if not any(coeffs):
                 raise ValueError("%s.curve.%s is identically zero" % (where, key))
-    if views:
-        _name(params.get("normal_group"), "normal_group", limit, seen)
     return params
 
 

@@ -107,7 +107,7 @@ def _set_preview(tree, path):
         bpy.ops.ed.lib_id_load_custom_preview(filepath=path)
 
 
-def render_previews(built, params, directory):
+def render_previews(built, directory):
     """Render a preview for every group of `built` (groups.py's build_all) with a
     BSDF output, into `directory`, and set it as the custom preview of that
     group and of the groups without one that belong to it (the normal group
@@ -136,7 +136,7 @@ def render_previews(built, params, directory):
                 for helper in helpers:
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
-            normal = by_name.get(params.get("normal_group"))
+            normal = by_name.get(spec.get("normal_group"))
             first_view = view.get("shader_group") or layered.get("shader_group")
             if normal is not None and first_view in shown:
                 _set_preview(normal, shown[first_view])

@@ -23,9 +23,9 @@
 # ---------------------------------------------------------------------------
 import bpy
 
-def view_correction_sockets():
+def view_correction_sockets(spec):
     """Roughness, Color, Normal [, Bump Map Correction] -> Color, Gain."""
-    return CORRECTION_SOCKETS[:2] + [NORMAL_INPUT] + bump_map_correction_inputs() + [
+    return CORRECTION_SOCKETS[:2] + [NORMAL_INPUT] + bump_map_correction_inputs(spec) + [
         CORRECTION_SOCKETS[2],
         {"in_out": "OUTPUT", "name": "Gain", "type": "NodeSocketFloat",
          "description": "Brightness gain 1 / E(mu, r) of a white surface for this "
@@ -33,9 +33,9 @@ def view_correction_sockets():
     ]
 
 
-def view_shader_sockets(output_description):
+def view_shader_sockets(spec, output_description):
     """Color, Roughness, Normal [, Bump Map Correction] -> BSDF."""
-    return SHADER_SOCKETS[:3] + bump_map_correction_inputs() + [
+    return SHADER_SOCKETS[:3] + bump_map_correction_inputs(spec) + [
         {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
          "description": output_description},
     ]
@@ -169,10 +169,10 @@ def albedo_lookup(tree, view, roughness_socket, mu_socket, x, frame, average=Fal
     return e, e_avg, chain.column + 1
 
 
-def view_cosine(tree, params, group_in, x, frame):
-    """The normal group's node, fed by the group's Normal: returns the view
-    cosine at the normal the BSDF shades with."""
-    normal_tree = bpy.data.node_groups[params["normal_group"]]
+def view_cosine(tree, spec, group_in, x, frame):
+    """The spec's normal group's node, fed by the group's Normal: returns the
+    view cosine at the normal the BSDF shades with."""
+    normal_tree = bpy.data.node_groups[spec["normal_group"]]
     node = normal_group_node(tree, normal_tree, group_in, (FRAME_INSET + COLUMN_STEP * x, -ROW_STEP), frame)
     return node.outputs["View Cosine"]
 
@@ -223,14 +223,14 @@ def build_view_correction_group(spec, params):
     """Roughness, Color, Normal -> Color, Gain with Gain = 1 / E(mu, r)."""
     view = spec["view"]
     tree = reuse_or_create_group(view["correction_group"])
-    ensure_interface(tree, view_correction_sockets())
+    ensure_interface(tree, view_correction_sockets(spec))
     nodes, links = tree.nodes, tree.links
     group_in = nodes.new("NodeGroupInput")
     group_in.location = (0.0, 0.0)
     physical = params.get("color_model") == "physical"
     frame = new_frame(tree, "Albedo frame", "Gain = 1 / E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
-    mu = view_cosine(tree, params, group_in, 1, frame)
+    mu = view_cosine(tree, spec, group_in, 1, frame)
     albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame, average=physical)
     gain = math_node(tree, "DIVIDE", "Gain = 1 / E", (FRAME_INSET + COLUMN_STEP * column + 100.0, 0.0),
                      frame, "Gain")
@@ -267,10 +267,12 @@ def build_view_correction_group(spec, params):
         "Color is multiplied by Gain, so the surface's albedo is exactly Color.")
     description = description_text(spec, params, (
         "View-dependent brightness gain for Blender's %s Glossy BSDF: Gain = 1 / E(mu, r), "
-        "with mu = N' · I at the normal the BSDF really shades with (Normal, raised as Cycles "
-        "raises it; see '%s') and E read from the packed table '%s', so every pixel of an "
-        "evenly lit white surface is 100 %%. %s"
-        % (spec["distribution"], params["normal_group"], view["image"], colour)))
+        "with mu = N' · I at the normal the BSDF really shades with (Normal, %s; see '%s') "
+        "and E read from the packed table '%s', so every pixel of an evenly lit white surface "
+        "is 100 %%. %s"
+        % (spec["distribution"],
+           "as EEVEE takes it" if is_eevee(spec) else "raised as Cycles raises it",
+           spec["normal_group"], view["image"], colour)))
     set_tree_description(tree, description)
     mark_asset(tree, description, ["gloffuse", spec["distribution"], "view"],
                asset_fields(params, "helper"))
@@ -285,7 +287,7 @@ def build_view_shader_group(spec, params, correction_tree):
     return build_glossy_group(spec["view"]["shader_group"], spec, params, correction_tree,
                               description,
                               ["gloffuse", spec["distribution"], "view"],
-                              view_shader_sockets("Brightness-corrected glossy BSDF"))
+                              view_shader_sockets(spec, "Brightness-corrected glossy BSDF"))
 
 
 def build_multiscatter_group(spec, params):
@@ -295,14 +297,14 @@ def build_multiscatter_group(spec, params):
     view = spec["view"]
     tree = reuse_or_create_group(view["multiscatter_group"])
     ensure_interface(tree, view_shader_sockets(
-        "Glossy BSDF plus a diffuse lobe carrying the energy it loses"))
+        spec, "Glossy BSDF plus a diffuse lobe carrying the energy it loses"))
     nodes, links = tree.nodes, tree.links
     group_in = nodes.new("NodeGroupInput")
     group_in.location = (0.0, 0.0)
     physical = params.get("color_model") == "physical"
     frame = new_frame(tree, "Albedo frame", "Lost energy 1 - E(mu, r), mu at the shaded normal")
     r = clamped_roughness(tree, group_in, frame)
-    mu = view_cosine(tree, params, group_in, 1, frame)
+    mu = view_cosine(tree, spec, group_in, 1, frame)
     albedo, e_avg, column = albedo_lookup(tree, view, r, mu, 2, frame, average=physical)
     x = FRAME_INSET + COLUMN_STEP * column + 100.0
     lost = math_node(tree, "SUBTRACT", "1 - E", (x, 0.0), frame, "Lost")
@@ -332,7 +334,7 @@ def build_multiscatter_group(spec, params):
         "brightening the highlight. mu is read at the normal the glossy BSDF shades with (see '%s')."
         % (spec["distribution"],
            "Color × Fms × (1 - E(mu, r)), Fms = C E_avg / (1 - C (1 - E_avg)) (physical colour)"
-           if physical else "Color × (1 - E(mu, r))", params["normal_group"])))
+           if physical else "Color × (1 - E(mu, r))", spec["normal_group"])))
     set_tree_description(tree, description)
     mark_asset(tree, description, ["gloffuse", spec["distribution"], "multiscatter"],
                asset_fields(params, "shader"))

@@ -3,7 +3,7 @@
 # tests/materials_e2e.rs after the library parts and furnace.py (so it builds
 # the groups and the world exactly as gloffuse does).
 #
-# A white furnace, but not a lab sphere: a perspective camera, an off-centre
+# A white furnace (in the scene section's "engine", Cycles by default), but not a lab sphere: a perspective camera, an off-centre
 # smooth sphere whose normal is tilted by a Noise texture (a procedural normal
 # map) and whose roughness comes from a texture (r0 -> r1 across the object's x). Every
 # variant of the document's "scene" section is rendered on that sphere, one
@@ -142,11 +142,16 @@ def variant_material(scene, variant):
 def build_scene(scene):
     render_scene = bpy.context.scene
     size = scene["resolution"]
-    settings = {"engine": "cycles", "cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
+    engine = scene.get("engine", "cycles")
+    settings = {"engine": engine, "cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
+    # The world first: some of EEVEE's settings are the world's.
+    render_scene.world = furnace_world()  # noqa: F821 -- furnace.py
     furnace_render_settings(render_scene, settings, 1, 1)  # noqa: F821 -- furnace.py
     # A point-like pixel filter: every sample of a pixel hits the same point.
-    render_scene.cycles.filter_width = 0.01
-    render_scene.world = furnace_world()  # noqa: F821 -- furnace.py
+    if engine == "cycles":
+        render_scene.cycles.filter_width = 0.01
+    else:
+        render_scene.render.filter_size = 0.0
 
     data = bpy.data.cameras.new("Scene camera")
     data.lens = 50.0
@@ -182,7 +187,8 @@ def scene_main():
     for variant in scene["variants"]:
         sphere.data.materials[0] = variant_material(scene, variant)
         probe = variant["kind"] == "probe"
-        render_scene.cycles.samples = scene["probe_samples"] if probe else scene["samples"]
+        if render_scene.render.engine == "CYCLES":
+            render_scene.cycles.samples = scene["probe_samples"] if probe else scene["samples"]
         path = os.path.join(scene["output_dir"], variant["name"] + ".exr")
         render_sweep(path)  # noqa: F821 -- furnace.py
         written.append(path)
