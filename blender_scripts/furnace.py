@@ -86,7 +86,8 @@ def furnace_sphere_spec(index, sphere):
     shader = sphere.get("shader")
     spec = {"shader": shader, "roughness": roughness}
     if shader in ("mix", "principled") or (shader == "group" and "ior" in sphere):
-        spec["ior"] = furnace_number(sphere, "ior", float, 1.0, 3.0)
+        # gloffuse checks the upper bound (the layered table's last slice).
+        spec["ior"] = furnace_number(sphere, "ior", float, 1.0)
     if shader in ("plain", "mix"):
         distribution = sphere.get("distribution")
         furnace_require(distribution in FURNACE_PLAIN_DISTRIBUTIONS,

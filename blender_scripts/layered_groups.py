@@ -20,8 +20,8 @@
 # view_groups.py (whose albedo_lookup, grid_cell, read_cell and bilinear it uses). Functions and constants only.
 # ---------------------------------------------------------------------------
 
+# An index of 1 is no coat at all; the table's last slice (coat_table.ior_max) is the top.
 LAYERED_IOR_MIN = 1.0
-LAYERED_IOR_MAX = 3.0
 
 
 def layered_sockets(spec):
@@ -32,7 +32,8 @@ def layered_sockets(spec):
         {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
          "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness of the coat (0..1)"},
         {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
-         "default": 1.5, "min": LAYERED_IOR_MIN, "max": LAYERED_IOR_MAX,
+         "default": 1.5, "min": LAYERED_IOR_MIN,
+         "max": float(spec["layered"]["coat_table"]["ior_max"]),
          "description": "Index of refraction of the coat (1 = no coat)"},
         {"in_out": "INPUT", "name": "Specular Tint", "type": "NodeSocketColor",
          "default": (1.0, 1.0, 1.0, 1.0),
@@ -73,8 +74,9 @@ def coat_lookup(tree, layered, chain, roughness, mu, ior, frame):
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4), for n clamped to the table's range.
-    n = chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, LAYERED_IOR_MAX), ior,
-                    LAYERED_IOR_MIN, LAYERED_IOR_MAX)
+    ior_max = float(table["ior_max"])
+    n = chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, ior_max), ior,
+                    LAYERED_IOR_MIN, ior_max)
     ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
                        chain.math("ADD", "n + 1", n, 1.0))
     z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))

@@ -161,6 +161,8 @@ def validate_params(params):
                     isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
                 raise ValueError("%s.layered.coat_table needs integer size and slices of at "
                                  "least 2" % where)
+            if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
+                raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))

@@ -92,6 +92,8 @@ pub struct CoatTable {
     pub size: usize,
     pub slices: usize,
     pub ior: Vec<f64>,
+    /// The index of the last slice: the groups clamp their IOR input to [1, this].
+    pub ior_max: f64,
     /// `z = F0^¼` of the last slice (the first is 0).
     pub z_max: f64,
     /// Image rows, bottom first: `values[i * size * slices + k * size + j]`.
@@ -114,6 +116,7 @@ impl CoatTable {
             size,
             slices: coat::SLICES,
             ior: grid.ior.to_vec(),
+            ior_max: coat::IOR_MAX,
             z_max: coat::slice_coordinate(coat::IOR_MAX),
             values,
         }

@@ -518,6 +518,8 @@ def validate_params(params):
                     isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
                 raise ValueError("%s.layered.coat_table needs integer size and slices of at "
                                  "least 2" % where)
+            if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
+                raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))
@@ -1701,8 +1703,8 @@ def build_multiscatter_group(spec, params):
 # view_groups.py (whose albedo_lookup, grid_cell, read_cell and bilinear it uses). Functions and constants only.
 # ---------------------------------------------------------------------------
 
+# An index of 1 is no coat at all; the table's last slice (coat_table.ior_max) is the top.
 LAYERED_IOR_MIN = 1.0
-LAYERED_IOR_MAX = 3.0
 
 
 def layered_sockets(spec):
@@ -1713,7 +1715,8 @@ def layered_sockets(spec):
         {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
          "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness of the coat (0..1)"},
         {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
-         "default": 1.5, "min": LAYERED_IOR_MIN, "max": LAYERED_IOR_MAX,
+         "default": 1.5, "min": LAYERED_IOR_MIN,
+         "max": float(spec["layered"]["coat_table"]["ior_max"]),
          "description": "Index of refraction of the coat (1 = no coat)"},
         {"in_out": "INPUT", "name": "Specular Tint", "type": "NodeSocketColor",
          "default": (1.0, 1.0, 1.0, 1.0),
@@ -1754,8 +1757,9 @@ def coat_lookup(tree, layered, chain, roughness, mu, ior, frame):
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4), for n clamped to the table's range.
-    n = chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, LAYERED_IOR_MAX), ior,
-                    LAYERED_IOR_MIN, LAYERED_IOR_MAX)
+    ior_max = float(table["ior_max"])
+    n = chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, ior_max), ior,
+                    LAYERED_IOR_MIN, ior_max)
     ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
                        chain.math("ADD", "n + 1", n, 1.0))
     z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
