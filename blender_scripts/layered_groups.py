@@ -66,7 +66,7 @@ def coat_image(layered):
     return packed_float_image(layered["coat_image"], cells * slices, cells, pixels)
 
 
-def coat_lookup(tree, layered, chain, roughness, mu, ior, frame):
+def coat_lookup(layered, chain, roughness, mu, ior):
     """Nodes that read A(mu, r, IOR): the two slices around the index, each
     interpolated bilinearly in (r, mu), mixed linearly in z = F0^(1/4).
     Returns the A socket."""
@@ -80,11 +80,10 @@ def coat_lookup(tree, layered, chain, roughness, mu, ior, frame):
     ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
                        chain.math("ADD", "n + 1", n, 1.0))
     z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
-    s = chain.math("MULTIPLY", "slice position z (K-1) / z_max", z, (slices - 1) / z_max)
-    k = chain.math("MINIMUM", "k = min(floor, K - 2)", chain.math("FLOOR", "floor", s),
-                   slices - 2.0)
-    t = chain.math("SUBTRACT", "t = position - k", s, k)
-    column, across = grid_cell(chain, roughness, size, "r")  # view_groups.py
+    # The slices are a grid over z / z_max in [0, 1], as r and mu are over theirs.
+    k, t = grid_cell(chain, chain.math("MULTIPLY", "z / z_max", z, 1.0 / z_max), slices,
+                     "z")  # view_groups.py
+    column, across = grid_cell(chain, roughness, size, "r")
     row, up = grid_cell(chain, mu, size, "mu")
     image = coat_image(layered)
     # Slice k's cells start at column k (size - 1); slice k + 1's one slice on.
@@ -111,7 +110,7 @@ def build_layered_group(spec, params):
     mu = view_cosine(tree, spec, group_in, 1, frame)
     albedo, _, column = albedo_lookup(tree, layered, r, mu, 2, frame)
     chain = Chain(tree, frame, column=column, y=0.0)
-    a = coat_lookup(tree, layered, chain, r, mu, group_in.outputs["IOR"], frame)
+    a = coat_lookup(layered, chain, r, mu, group_in.outputs["IOR"])
     weight = chain.math("DIVIDE", "A / E", a, albedo, name="Coat weight")
     glossy_color = chain.vector("SCALE", "Specular Tint × A / E", group_in.outputs["Specular Tint"],
                                 weight, name="Coat colour")
