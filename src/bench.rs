@@ -49,7 +49,6 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
     )?;
     let rs: Vec<f64> = b.roughness.iter().map(|r| r.get()).collect();
     let plan = Plan::verify(&Distribution::ALL, &rs, &[], b.render);
-    let timeout = b.blender.timeout;
     let start = Instant::now();
     render(
         &blender,
@@ -57,7 +56,7 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
         &groups,
         Mode::Roughness,
         [1.0; 3],
-        timeout,
+        &b.blender,
         &Quiet,
     )?;
     let one = start.elapsed().as_secs_f64();
@@ -79,7 +78,7 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
             &groups,
             Mode::Roughness,
             [1.0; 3],
-            timeout,
+            &b.blender,
             &Quiet,
         );
         if let Err(e) = rendered {

@@ -5,12 +5,13 @@ use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A value given on the command line or in a file is not acceptable.
-    #[error("invalid {what} '{value}': expected {expected}")]
+    /// A value given to the library is not acceptable. `field` names it in the library's
+    /// terms; the CLI names the flag that sets it instead (see [`Error::render`]).
+    #[error("{}", self.hint())]
     Input {
-        what: String,
+        field: Field,
         value: String,
-        expected: String,
+        expected: Hint,
     },
 
     /// A fit cannot be made from the points given.
@@ -36,9 +37,9 @@ pub enum Error {
 
     /// A Blender (or bpy) was found but could not be used, or a run in it failed. `log` is
     /// the file that holds its output; `command` the shell-quoted command to rerun it.
-    #[error("{}", blender_display(message, log.as_deref(), command.as_deref()))]
+    #[error("{}", self.hint())]
     Blender {
-        message: String,
+        message: Hint,
         log: Option<PathBuf>,
         command: Option<String>,
     },
@@ -48,8 +49,8 @@ pub enum Error {
     Exr(#[from] ExrError),
 
     /// No usable Blender: the message says where gloffuse looked and how to point at one.
-    #[error("{0}")]
-    BlenderNotFound(String),
+    #[error("{}", self.hint())]
+    BlenderNotFound(Hint),
 
     /// The user interrupted a Blender run (Ctrl-C): it was stopped, and nothing written.
     #[error("interrupted: Blender was stopped and nothing was written{}", log.as_ref().map(|l| format!(" (its log: {})", l.display())).unwrap_or_default())]
@@ -58,25 +59,242 @@ pub enum Error {
 
 /// A one-line message gets `; log: …; command: …` appended; a multi-line one (quoted
 /// output) gets them on lines of their own, so the path and command are easy to copy.
-fn blender_display(message: &str, log: Option<&std::path::Path>, command: Option<&str>) -> String {
-    let sep = if message.contains('\n') { "\n  " } else { "; " };
-    let mut s = message.trim_end().to_string();
+fn blender_hint(message: &Hint, log: Option<&std::path::Path>, command: Option<&str>) -> Hint {
+    let sep = if message.to_string().contains('\n') {
+        "\n  "
+    } else {
+        "; "
+    };
+    let mut s = message.clone().trim_end();
     if let Some(log) = log {
-        s.push_str(&format!("{sep}log: {}", log.display()));
+        s = s.then(Hint::text(format!("{sep}log: {}", log.display())));
     }
     if let Some(command) = command {
-        s.push_str(&format!("{sep}command: {command}"));
+        s = s.then(Hint::text(format!("{sep}command: {command}")));
     }
     s
 }
 
 impl Error {
-    pub fn input(what: &str, value: &str, expected: &str) -> Self {
+    /// `field` was given as `value`; `expected` says what would be right.
+    pub fn input(field: Field, value: impl ToString, expected: impl Into<Hint>) -> Self {
         Error::Input {
-            what: what.to_string(),
+            field,
             value: value.to_string(),
-            expected: expected.to_string(),
+            expected: expected.into(),
         }
+    }
+
+    /// The message, with each field named by `name`: [`Field::name`] in the library's own
+    /// words (the `Display` text), a flag where the CLI renders it.
+    pub fn render(&self, name: impl Fn(Field) -> String) -> String {
+        self.hint().render(name)
+    }
+
+    /// The message as a [`Hint`], its fields still unnamed.
+    pub fn hint(&self) -> Hint {
+        match self {
+            Error::Input {
+                field,
+                value,
+                expected,
+            } => Hint::new("invalid {}", [*field])
+                .then(Hint::text(format!(" '{value}': expected ")))
+                .then(expected.clone()),
+            Error::Blender {
+                message,
+                log,
+                command,
+            } => blender_hint(message, log.as_deref(), command.as_deref()),
+            Error::BlenderNotFound(message) => message.clone(),
+            other => Hint::text(other.to_string()),
+        }
+    }
+}
+
+/// An input of a library call, in the library's own terms. The library never spells a
+/// command-line flag: the CLI maps each field to the flag that sets it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Field {
+    /// The combination of inputs as a whole (none of them alone is wrong).
+    Arguments,
+    /// The Blender to run: an executable, or a Python that imports bpy.
+    Blender,
+    /// The Blender version whose BSDFs are modelled.
+    BlenderVersion,
+    /// The .blend library to write.
+    Blend,
+    Coefficients,
+    Color,
+    /// The geometry of a contact sheet of renders.
+    ContactSheet,
+    /// The degree of a fitted polynomial.
+    Degree,
+    Distribution,
+    Engine,
+    /// The Blender extension (.zip) to write.
+    Extension,
+    /// A table's file format.
+    Format,
+    /// The masking function of a split-sum table.
+    GModel,
+    /// The user's existing .blend to update in place.
+    Into,
+    /// Indices of refraction.
+    Ior,
+    /// Which lookup table.
+    Kind,
+    /// How a split-sum table is integrated.
+    Method,
+    /// The correction mode.
+    Mode,
+    /// A classic BRDF model.
+    Model,
+    /// The setting that forbids installing bpy when no Blender is found.
+    NoProvision,
+    /// A parameter of a classic BRDF model, named as the model names it.
+    ModelParameter(&'static str),
+    /// The file to write.
+    Out,
+    /// A measured point ROUGHNESS:PERCENT, its roughness, its percent.
+    Point,
+    PointRoughness,
+    PointPercent,
+    /// The report directory.
+    Report,
+    Roughness,
+    Samples,
+    /// The Python script to write.
+    Script,
+    /// Texels per side.
+    Size,
+    /// How long Blender may run.
+    Timeout,
+    /// A view cosine μ.
+    ViewCosine,
+}
+
+impl Field {
+    /// The field in words, as the library's own messages name it.
+    pub fn name(self) -> String {
+        match self {
+            Field::Arguments => "arguments",
+            Field::Blender => "Blender",
+            Field::BlenderVersion => "Blender version",
+            Field::Blend => "library .blend",
+            Field::Coefficients => "coefficients",
+            Field::Color => "colour",
+            Field::ContactSheet => "contact sheet",
+            Field::Degree => "degree",
+            Field::Distribution => "distribution",
+            Field::Engine => "engine",
+            Field::Extension => "extension",
+            Field::Format => "format",
+            Field::GModel => "masking model",
+            Field::Into => "file to update",
+            Field::Ior => "index of refraction",
+            Field::Kind => "table kind",
+            Field::Method => "method",
+            Field::Mode => "mode",
+            Field::Model => "model",
+            Field::ModelParameter(name) => name,
+            Field::Out => "output",
+            Field::NoProvision => "the setting that forbids installing bpy",
+            Field::Point => "point",
+            Field::PointRoughness => "point roughness",
+            Field::PointPercent => "point percent",
+            Field::Report => "report directory",
+            Field::Roughness => "roughness",
+            Field::Samples => "samples",
+            Field::Script => "script",
+            Field::Size => "size",
+            Field::Timeout => "timeout",
+            Field::ViewCosine => "view cosine mu",
+        }
+        .to_string()
+    }
+}
+
+/// Text that may name fields: what an input should have been, or a message that tells the
+/// user which input to change.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Hint(Vec<Piece>);
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Piece {
+    Text(String),
+    Field(Field),
+}
+
+impl Hint {
+    /// `Hint::new("nothing with {} coat", [Field::Kind])`: each `{}` in the template stands
+    /// for the next field. Text from elsewhere (a log, a path) goes in by [`Hint::text`].
+    pub fn new(template: impl AsRef<str>, fields: impl IntoIterator<Item = Field>) -> Self {
+        let template = template.as_ref();
+        let mut fields = fields.into_iter();
+        let mut pieces = Vec::new();
+        for (i, text) in template.split("{}").enumerate() {
+            if i > 0 {
+                let field = fields.next().expect("a hint has a field for every {}");
+                pieces.push(Piece::Field(field));
+            }
+            pieces.push(Piece::Text(text.to_string()));
+        }
+        debug_assert!(fields.next().is_none(), "a hint has a {{}} for every field");
+        Hint(pieces)
+    }
+
+    /// Plain text, taken as it is.
+    pub fn text(text: impl Into<String>) -> Self {
+        Hint(vec![Piece::Text(text.into())])
+    }
+
+    /// Without trailing white space.
+    fn trim_end(mut self) -> Self {
+        while let Some(Piece::Text(text)) = self.0.last_mut() {
+            let kept = text.trim_end().len();
+            text.truncate(kept);
+            if !text.is_empty() {
+                break;
+            }
+            self.0.pop();
+        }
+        self
+    }
+
+    /// This hint followed by `more`.
+    pub fn then(mut self, more: Hint) -> Self {
+        self.0.extend(more.0);
+        self
+    }
+
+    /// The text with each field named by `name`.
+    pub fn render(&self, name: impl Fn(Field) -> String) -> String {
+        self.0
+            .iter()
+            .map(|piece| match piece {
+                Piece::Text(text) => text.clone(),
+                Piece::Field(field) => name(*field),
+            })
+            .collect()
+    }
+}
+
+impl From<&str> for Hint {
+    fn from(text: &str) -> Self {
+        Hint::text(text)
+    }
+}
+
+impl From<String> for Hint {
+    fn from(text: String) -> Self {
+        Hint::text(text)
+    }
+}
+
+impl std::fmt::Display for Hint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.render(Field::name))
     }
 }
 

@@ -20,4 +20,4 @@ pub mod refresh;
 pub mod report;
 pub mod verify;
 
-pub use error::{Error, Result};
+pub use error::{Error, Field, Hint, Result};

@@ -181,7 +181,7 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
 pub fn report_dir(dir: &Path) -> Result<(), Error> {
     match std::fs::metadata(dir) {
         Ok(m) if m.is_dir() => Ok(()),
-        Ok(_) => Err(fail(dir, "--report needs a directory, and this is a file")),
+        Ok(_) => Err(fail(dir, "a report needs a directory, and this is a file")),
         Err(_) => {
             let parent = match dir.parent() {
                 Some(d) if !d.as_os_str().is_empty() => d,
@@ -192,7 +192,7 @@ pub fn report_dir(dir: &Path) -> Result<(), Error> {
                 Ok(_) => Err(fail(
                     dir,
                     format!(
-                        "--report needs a directory, but {} is a file",
+                        "a report needs a directory, but {} is a file",
                         parent.display()
                     ),
                 )),

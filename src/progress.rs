@@ -7,6 +7,10 @@
 pub trait Progress: Sync {
     /// A one-line notice for the user (which Blender is used, that bpy is being installed).
     fn notice(&self, _message: &str) {}
+    /// A notice that tells the user which input to change: the CLI names the flags.
+    fn advise(&self, hint: &crate::Hint) {
+        self.notice(&hint.to_string());
+    }
     /// A task of `steps` steps starts; `message` says what it does.
     fn begin(&self, _message: &str, _steps: u64) {}
     /// `done` steps of the current task are finished.

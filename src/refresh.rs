@@ -114,7 +114,7 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
         &groups,
         Mode::Roughness,
         [1.0; 3],
-        a.blender.timeout,
+        &a.blender,
         progress,
     )?;
 

@@ -147,7 +147,7 @@ fn cases() -> Vec<Case> {
         case(&[
             "fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "9", "--out", "@/c.json",
         ])
-        .says(&["invalid degree '9'", "from 2 to 8"])
+        .says(&["invalid --degree '9'", "from 2 to 8"])
         .writes_nothing_to(&["@/c.json"]),
         case(&[
             "fit",
@@ -158,7 +158,7 @@ fn cases() -> Vec<Case> {
             "--out",
             "@/c.json",
         ])
-        .says(&["invalid degree '1'", "from 2 to 8"])
+        .says(&["invalid --degree '1'", "from 2 to 8"])
         .writes_nothing_to(&["@/c.json"]),
         case(&["fit", "--from", "magic", "--out", "@/c.json"])
             .says(&["'magic' for '--from", "integrator"])
@@ -514,14 +514,14 @@ fn cases() -> Vec<Case> {
             .file("notes.txt", "notes\n")
             .says(&[
                 "cannot write @/notes.txt",
-                "--report needs a directory, and this is a file",
+                "a report needs a directory, and this is a file",
             ]),
         case(&["verify", "--report", "@/notes.txt/report"])
             .no_blender()
             .file("notes.txt", "notes\n")
             .says(&[
                 "cannot write @/notes.txt/report",
-                "--report needs a directory, but @/notes.txt is a file",
+                "a report needs a directory, but @/notes.txt is a file",
             ]),
         // The one row whose input is fine: then the missing Blender is what is reported, and
         // the report directory is not made.

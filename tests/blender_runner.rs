@@ -82,6 +82,7 @@ fn run_of<'a>(blender: &'a Blender, script: &'a Path, dir: &Path, timeout: u64) 
         script,
         args: vec!["--spheres".into(), "a b".into(), "it's".into()],
         timeout: Duration::from_secs(timeout),
+        cancel: Default::default(),
         log: dir.join("run.log"),
     }
 }
@@ -92,7 +93,7 @@ fn blender_error(e: Error) -> (String, Option<PathBuf>, Option<String>) {
             message,
             log,
             command,
-        } => (message, log, command),
+        } => (message.to_string(), log, command),
         other => panic!("expected Error::Blender, got {other:?}"),
     }
 }
@@ -160,8 +161,14 @@ fn a_hang_is_killed_with_its_whole_process_group() {
     assert!(took < Duration::from_secs(10), "{took:?}");
     let shown = err.to_string();
     assert!(
-        shown.starts_with("Blender timed out after 2 s (--timeout); log: "),
+        shown.starts_with("Blender timed out after 2 s (timeout); log: "),
         "{shown}"
+    );
+    // The field is typed, so the CLI can name its flag.
+    let typed = err.render(|f| format!("<{f:?}>"));
+    assert!(
+        typed.starts_with("Blender timed out after 2 s (<Timeout>); log: "),
+        "{typed}"
     );
     assert!(shown.contains("; command: "), "{shown}");
     assert!(run.log.exists());
@@ -637,6 +644,7 @@ fn check_real(label: &str, kind: BlenderKind, major: u32, minor: u32) {
         script: &script,
         args: vec!["a b".into(), "ünï".into(), "--x=1".into()],
         timeout: Duration::from_secs(120),
+        cancel: Default::default(),
         log: dir.path().join("ok.log"),
     };
     let out = run_script(&run).unwrap_or_else(|e| panic!("{e}"));

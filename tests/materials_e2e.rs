@@ -94,6 +94,7 @@ fn render(
         script: &script,
         args: Vec::new(),
         timeout: Duration::from_secs(900),
+        cancel: Default::default(),
         log: dir.join("scene.log"),
     };
     run_script(&run).unwrap_or_else(|e| panic!("Blender {}: {e}", blender.version_string));

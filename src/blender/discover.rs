@@ -13,8 +13,9 @@ use std::time::{Duration, Instant};
 
 use super::environment::{BPY_SERIES, ENV_VAR, Environment, bpy_venv_dir, venv_python, which};
 use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, probe_as};
+use super::process::Cancel;
 use super::provision::{InstallerOutput, provision};
-use crate::Error;
+use crate::error::{Error, Field, Hint};
 use crate::progress::Progress;
 
 #[derive(Clone, Debug)]
@@ -25,9 +26,11 @@ pub struct FindOptions {
     pub allow_provision: bool,
     /// Where pip's output goes while provisioning.
     pub installer_output: InstallerOutput,
-    /// The whole search (every version probe) ends within this (`--timeout`); installing
-    /// bpy is not bounded by it.
+    /// The whole search (every version probe) ends within this; installing bpy is not
+    /// bounded by it.
     pub timeout: Duration,
+    /// Stops a probe or an install in progress.
+    pub cancel: Cancel,
 }
 
 impl Default for FindOptions {
@@ -37,6 +40,7 @@ impl Default for FindOptions {
             allow_provision: false,
             installer_output: InstallerOutput::default(),
             timeout: PROBE_TIMEOUT,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -129,28 +133,38 @@ pub fn find_blender_in(
 ) -> Result<Blender, Error> {
     // Every place looked at, for the not-found message; the candidates that were there but
     // could not be used, for the provisioning notice.
-    let mut looked: Vec<String> = Vec::new();
-    let mut skipped: Vec<String> = Vec::new();
+    let mut looked: Vec<Hint> = Vec::new();
+    let mut skipped: Vec<Hint> = Vec::new();
     let deadline = Instant::now() + opts.timeout;
     for step in search_plan(opts, env) {
         match step {
-            Step::Absent { place } => looked.push(place),
+            Step::Absent { place } => looked.push(Hint::text(place)),
             Step::Probe {
                 source,
                 program,
                 kind,
                 required,
-            } => match probe_as(&program, kind, source, deadline) {
+            } => match probe_as(&program, kind, source, deadline, &opts.cancel) {
                 Ok(b) => return Ok(b),
                 Err(e) if required => return Err(e),
                 Err(e) => {
-                    let why = format!("{source} ({}): {e}", program.display());
+                    let why = source
+                        .hint()
+                        .then(Hint::text(format!(" ({}): ", program.display())))
+                        .then(e.hint());
                     looked.push(why.clone());
                     skipped.push(why);
                 }
             },
             Step::Provision { venv } if opts.allow_provision => {
-                return provision(&venv, env, opts.installer_output, &skipped, progress);
+                return provision(
+                    &venv,
+                    env,
+                    opts.installer_output,
+                    &skipped,
+                    progress,
+                    &opts.cancel,
+                );
             }
             Step::Provision { .. } => {}
         }
@@ -158,16 +172,18 @@ pub fn find_blender_in(
     Err(not_found(&looked))
 }
 
-fn not_found(looked: &[String]) -> Error {
-    let mut m = String::from("no Blender found. gloffuse looked at:");
+fn not_found(looked: &[Hint]) -> Error {
+    let mut m = Hint::text("no Blender found. gloffuse looked at:");
     for l in looked {
-        m.push_str("\n  - ");
-        m.push_str(l);
+        m = m.then(Hint::text("\n  - ")).then(l.clone());
     }
-    m.push_str(&format!(
-        "\nPoint it at one with --blender PATH or {ENV_VAR}=PATH (a blender executable, or a \
-         Python that imports bpy), install one (apt-get install blender), or drop \
-         --no-provision to let gloffuse install bpy {BPY_SERIES} LTS (~370 MB) into its cache."
-    ));
-    Error::BlenderNotFound(m)
+    let advice = Hint::new(
+        format!(
+            "\nPoint it at one with {{}} PATH or {ENV_VAR}=PATH (a blender executable, or a \
+             Python that imports bpy), install one (apt-get install blender), or drop {{}} to \
+             let gloffuse install bpy {BPY_SERIES} LTS (~370 MB) into its cache."
+        ),
+        [Field::Blender, Field::NoProvision],
+    );
+    Error::BlenderNotFound(m.then(advice))
 }

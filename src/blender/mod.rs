@@ -14,6 +14,7 @@ pub mod runs;
 
 pub use discover::{FindOptions, find_blender};
 pub use probe::{Blender, BlenderKind, probe};
+pub use process::Cancel;
 pub use provision::InstallerOutput;
 pub use run::{Run, RunOutput, command_line, run_script};
 
@@ -36,6 +37,8 @@ pub struct BlenderOptions {
     /// Kill Blender (and its children) after this long; the search for Blender (its version
     /// probes) also ends within it.
     pub timeout: Duration,
+    /// Stops the Blender run in progress (and every later one) when requested.
+    pub cancel: Cancel,
 }
 
 impl Default for BlenderOptions {
@@ -45,6 +48,7 @@ impl Default for BlenderOptions {
             provision: true,
             installer_output: InstallerOutput::Log,
             timeout: Duration::from_secs(600),
+            cancel: Cancel::default(),
         }
     }
 }
@@ -58,6 +62,7 @@ impl BlenderOptions {
                 allow_provision: self.provision,
                 installer_output: self.installer_output,
                 timeout: self.timeout,
+                cancel: self.cancel.clone(),
             },
             progress,
         )?;

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::environment::{ENV_VAR, venv_python, which};
-use super::process::{Exit, format_seconds, run_captured, shell_join};
-use crate::Error;
+use super::process::{Cancel, Exit, format_seconds, run_captured, shell_join};
+use crate::error::{Error, Field, Hint};
 use crate::measure::BlenderVersion;
 
 /// How long a version probe may take at most (a cold Blender start on a slow disk can take
@@ -54,7 +54,7 @@ impl Blender {
 /// Where a candidate came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Source {
-    /// `--blender PATH`.
+    /// Given explicitly (the CLI's `--blender PATH`).
     Explicit,
     /// `$GLOFFUSE_BLENDER`.
     EnvVar,
@@ -64,14 +64,21 @@ pub enum Source {
     Cache,
 }
 
+impl Source {
+    /// The source as a message names it (the explicit one by its field).
+    pub fn hint(self) -> Hint {
+        match self {
+            Source::Explicit => Hint::new("{}", [Field::Blender]),
+            Source::EnvVar => Hint::text(ENV_VAR),
+            Source::SystemPath => Hint::text("`blender` on PATH"),
+            Source::Cache => Hint::text("the bpy cache"),
+        }
+    }
+}
+
 impl std::fmt::Display for Source {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Source::Explicit => "--blender",
-            Source::EnvVar => ENV_VAR,
-            Source::SystemPath => "`blender` on PATH",
-            Source::Cache => "the bpy cache",
-        })
+        self.hint().fmt(f)
     }
 }
 
@@ -86,6 +93,7 @@ pub fn probe(program: &Path) -> Result<Blender, Error> {
         None,
         Source::Explicit,
         Instant::now() + PROBE_TIMEOUT,
+        &Cancel::default(),
     )
 }
 
@@ -96,9 +104,15 @@ pub(super) fn probe_as(
     kind: Option<BlenderKind>,
     source: Source,
     deadline: Instant,
+    cancel: &Cancel,
 ) -> Result<Blender, Error> {
-    let named =
-        |what: &str| Error::BlenderNotFound(format!("{source} {}: {what}", program.display()));
+    let named = |what: &str| {
+        Error::BlenderNotFound(
+            source
+                .hint()
+                .then(Hint::text(format!(" {}: {what}", program.display()))),
+        )
+    };
     let program = if program.is_dir() {
         [program.join("blender"), venv_python(program)]
             .into_iter()
@@ -134,7 +148,7 @@ pub(super) fn probe_as(
     };
     let mut tried = Vec::new();
     for &k in order {
-        match probe_kind(&program, k, deadline)? {
+        match probe_kind(&program, k, deadline, cancel)? {
             Probed::Found(b) => return Ok(b),
             Probed::Not(attempt) => {
                 // Something that answered like Blender must not then be fed Python code:
@@ -147,20 +161,21 @@ pub(super) fn probe_as(
             }
         }
     }
-    let mut m = format!(
-        "{source} {} is neither a working Blender ({} or later) nor a Python that imports bpy",
+    let mut m = Hint::text(format!(
+        " {} is neither a working Blender ({} or later) nor a Python that imports bpy",
         program.display(),
         BlenderVersion::OLDEST
-    );
+    ));
     for t in &tried {
-        m.push_str(&format!("\n  `{}` {}", t.command, t.outcome));
+        m = m
+            .then(Hint::text(format!("\n  `{}` ", t.command)))
+            .then(t.outcome.clone());
         for line in last_lines(&t.output, 6) {
-            m.push_str("\n      ");
-            m.push_str(line);
+            m = m.then(Hint::text(format!("\n      {line}")));
         }
     }
     Err(Error::Blender {
-        message: m,
+        message: source.hint().then(m),
         log: None,
         command: None,
     })
@@ -168,7 +183,7 @@ pub(super) fn probe_as(
 
 struct Attempt {
     command: String,
-    outcome: String,
+    outcome: Hint,
     output: String,
 }
 
@@ -179,7 +194,12 @@ enum Probed {
 
 /// Runs one version probe, for at most [`PROBE_TIMEOUT`] and not past `deadline`.
 /// `Ok(Not)`: it did not answer as this kind. `Err`: it did, but as a Blender older than 3.0.
-fn probe_kind(program: &Path, kind: BlenderKind, deadline: Instant) -> Result<Probed, Error> {
+fn probe_kind(
+    program: &Path,
+    kind: BlenderKind,
+    deadline: Instant,
+    cancel: &Cancel,
+) -> Result<Probed, Error> {
     let mut argv: Vec<OsString> = vec![program.as_os_str().to_owned()];
     match kind {
         BlenderKind::Binary => {
@@ -194,7 +214,7 @@ fn probe_kind(program: &Path, kind: BlenderKind, deadline: Instant) -> Result<Pr
         ),
     }
     let command = shell_join(&argv);
-    let not = |outcome: String, output: String| {
+    let not = |outcome: Hint, output: String| {
         Ok(Probed::Not(Attempt {
             command: command.clone(),
             outcome,
@@ -205,26 +225,27 @@ fn probe_kind(program: &Path, kind: BlenderKind, deadline: Instant) -> Result<Pr
         .saturating_duration_since(Instant::now())
         .min(PROBE_TIMEOUT);
     if timeout.is_zero() {
-        return not("was not probed: --timeout ran out".into(), String::new());
+        return not(
+            Hint::new("was not probed: {} ran out", [Field::Timeout]),
+            String::new(),
+        );
     }
-    let (exit, output) = match run_captured(&argv, timeout) {
+    let (exit, output) = match run_captured(&argv, timeout, cancel) {
         Ok(r) => r,
-        Err(e) => return not(format!("could not be run: {e}"), String::new()),
+        Err(e) => return not(format!("could not be run: {e}").into(), String::new()),
     };
     match exit {
         Exit::Interrupted => return Err(Error::Interrupted { log: None }),
         Exit::TimedOut => {
-            let limit = if timeout < PROBE_TIMEOUT {
-                " (--timeout)"
+            let within = format!("did not answer within {} s", format_seconds(timeout));
+            let outcome = if timeout < PROBE_TIMEOUT {
+                Hint::text(within).then(Hint::new(" ({})", [Field::Timeout]))
             } else {
-                ""
+                Hint::text(within)
             };
-            return not(
-                format!("did not answer within {} s{limit}", format_seconds(timeout)),
-                output,
-            );
+            return not(outcome, output);
         }
-        Exit::Finished(s) if !s.success() => return not(format!("failed ({s})"), output),
+        Exit::Finished(s) if !s.success() => return not(format!("failed ({s})").into(), output),
         Exit::Finished(_) => {}
     }
     let reported = match kind {
@@ -248,14 +269,15 @@ fn probe_kind(program: &Path, kind: BlenderKind, deadline: Instant) -> Result<Pr
                      (older Glossy BSDFs are not modelled)",
                     program.display(),
                     BlenderVersion::OLDEST
-                ),
+                )
+                .into(),
                 log: None,
                 command: Some(command),
             });
         }
         Err(_) => {
             return not(
-                format!("reported an unrecognised version '{version_string}'"),
+                format!("reported an unrecognised version '{version_string}'").into(),
                 output,
             );
         }

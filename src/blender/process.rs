@@ -6,16 +6,59 @@ use std::fs::File;
 use std::io;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
 use std::process::{Command, ExitStatus, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-/// Set (by the binary's Ctrl-C handler) to ask the running child to be stopped: the wait
-/// loop of [`run_logged`] kills its process group and returns [`Exit::Interrupted`].
-pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+/// A way to stop Blender from outside: the caller keeps a clone (the CLI's Ctrl-C handler
+/// does) and passes one in with the options of every call that runs Blender. Clones share
+/// one state.
+#[derive(Clone, Debug, Default)]
+pub struct Cancel(Arc<CancelState>);
 
-/// True while [`run_logged`] waits for a child, so an interrupt handler knows there is one
-/// to stop (rather than ending the process at once).
-pub static CHILD_RUNNING: AtomicBool = AtomicBool::new(false);
+#[derive(Debug, Default)]
+struct CancelState {
+    requested: AtomicBool,
+    /// How many [`run_logged`] calls are waiting for a child right now.
+    waiting: AtomicUsize,
+}
+
+impl Cancel {
+    /// Asks every child being waited for to be stopped: their waits kill the process group
+    /// and return [`Exit::Interrupted`], and so does every later run. False when no child is
+    /// waited for (the caller may then end at once). Only atomics: safe in a signal handler.
+    pub fn request(&self) -> bool {
+        self.0.requested.store(true, Ordering::SeqCst);
+        self.0.waiting.load(Ordering::SeqCst) > 0
+    }
+
+    pub fn is_requested(&self) -> bool {
+        self.0.requested.load(Ordering::SeqCst)
+    }
+}
+
+/// Two handles are equal when they are clones of one another.
+impl PartialEq for Cancel {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// Counts a wait for [`Cancel::request`] while it lasts.
+struct Waiting<'a>(&'a Cancel);
+
+impl<'a> Waiting<'a> {
+    fn new(cancel: &'a Cancel) -> Self {
+        cancel.0.waiting.fetch_add(1, Ordering::SeqCst);
+        Waiting(cancel)
+    }
+}
+
+impl Drop for Waiting<'_> {
+    fn drop(&mut self) {
+        self.0.0.waiting.fetch_sub(1, Ordering::SeqCst);
+    }
+}
 
 /// How a child ended.
 #[derive(Debug)]
@@ -23,7 +66,8 @@ pub enum Exit {
     Finished(ExitStatus),
     /// The timeout passed; the child's process group was killed and the child reaped.
     TimedOut,
-    /// [`INTERRUPTED`] was set; the child's process group was killed and the child reaped.
+    /// [`Cancel::request`] was called; the child's process group was killed and the child
+    /// reaped.
     Interrupted,
 }
 
@@ -44,10 +88,15 @@ fn kill_group(child: &mut std::process::Child) -> io::Result<()> {
 }
 
 /// Runs `argv` in a process group of its own, stdin from /dev/null, stdout and stderr both
-/// to `out`, and waits at most `timeout`. On timeout, or when [`INTERRUPTED`] is set, the
+/// to `out`, and waits at most `timeout`. On timeout, or when `cancel` is requested, the
 /// whole group is killed (SIGKILL) and the child reaped, so neither it nor its children
 /// outlive the call.
-pub fn run_logged(argv: &[OsString], out: &File, timeout: Duration) -> io::Result<Exit> {
+pub fn run_logged(
+    argv: &[OsString],
+    out: &File,
+    timeout: Duration,
+    cancel: &Cancel,
+) -> io::Result<Exit> {
     let (program, args) = argv
         .split_first()
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "empty command"))?;
@@ -60,21 +109,23 @@ pub fn run_logged(argv: &[OsString], out: &File, timeout: Duration) -> io::Resul
         .env("PYTHONUNBUFFERED", "1")
         .process_group(0);
     die_with_parent(&mut cmd);
+    let _waiting = Waiting::new(cancel);
     let mut child = cmd.spawn()?;
-    CHILD_RUNNING.store(true, Ordering::SeqCst);
-    let exit = wait_for(&mut child, timeout);
-    CHILD_RUNNING.store(false, Ordering::SeqCst);
-    exit
+    wait_for(&mut child, timeout, cancel)
 }
 
-fn wait_for(child: &mut std::process::Child, timeout: Duration) -> io::Result<Exit> {
+fn wait_for(
+    child: &mut std::process::Child,
+    timeout: Duration,
+    cancel: &Cancel,
+) -> io::Result<Exit> {
     let start = Instant::now();
     let mut pause = Duration::from_millis(2);
     loop {
         if let Some(status) = child.try_wait()? {
             return Ok(Exit::Finished(status));
         }
-        if INTERRUPTED.load(Ordering::SeqCst) {
+        if cancel.is_requested() {
             kill_group(child)?;
             return Ok(Exit::Interrupted);
         }
@@ -113,9 +164,13 @@ fn die_with_parent(cmd: &mut Command) {
 fn die_with_parent(_cmd: &mut Command) {}
 
 /// Runs a short command with a timeout and returns its stdout and stderr (together, lossy).
-pub fn run_captured(argv: &[OsString], timeout: Duration) -> io::Result<(Exit, String)> {
+pub fn run_captured(
+    argv: &[OsString],
+    timeout: Duration,
+    cancel: &Cancel,
+) -> io::Result<(Exit, String)> {
     let out = tempfile::tempfile()?;
-    let exit = run_logged(argv, &out, timeout)?;
+    let exit = run_logged(argv, &out, timeout, cancel)?;
     let mut out = out;
     let mut bytes = Vec::new();
     use std::io::{Read, Seek};

@@ -11,8 +11,8 @@ use std::time::Instant;
 
 use super::environment::{BPY_REQUIREMENT, BPY_SERIES, ENV_VAR, Environment, venv_python, which};
 use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, last_lines, probe_as};
-use super::process::{Exit, run_captured, shell_join};
-use crate::Error;
+use super::process::{Cancel, Exit, run_captured, shell_join};
+use crate::error::{Error, Field, Hint};
 use crate::progress::Progress;
 
 /// Where the installer's (venv's and pip's) output goes.
@@ -35,8 +35,9 @@ pub(super) fn provision(
     venv: &Path,
     env: &Environment,
     output: InstallerOutput,
-    skipped: &[String],
+    skipped: &[Hint],
     progress: &dyn Progress,
+    cancel: &Cancel,
 ) -> Result<Blender, Error> {
     let quiet = output == InstallerOutput::Log;
     let parent = venv.parent().unwrap_or(Path::new("."));
@@ -45,7 +46,7 @@ pub(super) fn provision(
         message: e.to_string(),
     };
     // Fail before announcing or creating anything if the install cannot work.
-    let python = base_python(env)?;
+    let python = base_python(env, cancel)?;
     std::fs::create_dir_all(parent).map_err(|e| write_err(parent, &e))?;
     // One install at a time: a second gloffuse (a parallel CI job sharing the cache)
     // waits for the first, then uses what it installed.
@@ -56,16 +57,20 @@ pub(super) fn provision(
             Some(BlenderKind::PythonModule),
             Source::Cache,
             Instant::now() + PROBE_TIMEOUT,
+            cancel,
         );
     }
     remove_stale_partials(parent);
     for s in skipped {
-        progress.notice(&format!("not using {s}"));
+        progress.advise(&Hint::text("not using ").then(s.clone()));
     }
-    progress.notice(&format!(
-        "no Blender found; installing bpy {BPY_SERIES} LTS (Blender as a Python \
-         module, ~370 MB) into {} — point --blender or {ENV_VAR} at a Blender to skip this",
-        venv.display()
+    progress.advise(&Hint::new(
+        format!(
+            "no Blender found; installing bpy {BPY_SERIES} LTS (Blender as a Python \
+             module, ~370 MB) into {} — point {{}} or {ENV_VAR} at a Blender to skip this",
+            venv.display()
+        ),
+        [Field::Blender],
     ));
     let tmp = tempfile::Builder::new()
         .prefix(&format!(".bpy-{BPY_SERIES}.partial-"))
@@ -107,12 +112,15 @@ pub(super) fn provision(
                     message.push_str(line);
                 }
             }
-            message.push_str(&format!(
-                "\n  (bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or point \
-                 --blender or {ENV_VAR} at a Blender)"
-            ));
+            let advice = Hint::new(
+                format!(
+                    "\n  (bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or \
+                     point {{}} or {ENV_VAR} at a Blender)"
+                ),
+                [Field::Blender],
+            );
             Error::Blender {
-                message,
+                message: Hint::text(message).then(advice),
                 log: log.clone(),
                 command: Some(command.clone()),
             }
@@ -150,6 +158,7 @@ pub(super) fn provision(
         Some(BlenderKind::PythonModule),
         Source::Cache,
         Instant::now() + PROBE_TIMEOUT,
+        cancel,
     )?;
     if let Err(e) = std::fs::rename(tmp.path(), venv) {
         // Another gloffuse may have finished first; use its venv (ours is removed on drop).
@@ -164,6 +173,7 @@ pub(super) fn provision(
         Some(BlenderKind::PythonModule),
         Source::Cache,
         Instant::now() + PROBE_TIMEOUT,
+        cancel,
     ) {
         Ok(b) => Ok(b),
         Err(e) => {
@@ -222,7 +232,7 @@ fn remove_stale_partials(parent: &Path) {
 
 /// A Python 3.11 to make the venv with (bpy 4.5 wheels are for CPython 3.11 only):
 /// `python3.11`, else `python3` if it is 3.11.
-fn base_python(env: &Environment) -> Result<PathBuf, Error> {
+fn base_python(env: &Environment, cancel: &Cancel) -> Result<PathBuf, Error> {
     let mut seen = Vec::new();
     for name in ["python3.11", "python3"] {
         let Some(p) = which(name, env.path.as_deref()) else {
@@ -233,7 +243,7 @@ fn base_python(env: &Environment) -> Result<PathBuf, Error> {
             "-c".into(),
             "import sys; print('%d.%d' % sys.version_info[:2])".into(),
         ];
-        if let Ok((Exit::Finished(s), out)) = run_captured(&argv, PROBE_TIMEOUT) {
+        if let Ok((Exit::Finished(s), out)) = run_captured(&argv, PROBE_TIMEOUT, cancel) {
             let v = out
                 .lines()
                 .map(str::trim)
@@ -248,14 +258,19 @@ fn base_python(env: &Environment) -> Result<PathBuf, Error> {
             seen.push(format!("{} is Python {v}", p.display()));
         }
     }
-    Err(Error::BlenderNotFound(format!(
-        "no Blender found, and bpy {BPY_SERIES} cannot be installed: it needs CPython 3.11 \
-         (python3.11 or python3 on PATH){}. Install python3.11, or point --blender or \
-         {ENV_VAR} at a Blender (apt-get install blender).",
-        if seen.is_empty() {
-            String::new()
-        } else {
-            format!("; found {}", seen.join(", "))
-        }
-    )))
+    let found = if seen.is_empty() {
+        String::new()
+    } else {
+        format!("; found {}", seen.join(", "))
+    };
+    Err(Error::BlenderNotFound(
+        Hint::text(format!(
+            "no Blender found, and bpy {BPY_SERIES} cannot be installed: it needs CPython 3.11 \
+             (python3.11 or python3 on PATH){found}. "
+        ))
+        .then(Hint::new(
+            format!("Install python3.11, or point {{}} or {ENV_VAR} at a Blender (apt-get install blender)."),
+            [Field::Blender],
+        )),
+    ))
 }

@@ -7,8 +7,8 @@
 //! `sys.stdout.write("GLOFFUSE_RESULT " + json.dumps(result) + "\n"); sys.stdout.flush()`.
 
 use super::probe::{Blender, BlenderKind};
-use super::process::{Exit, describe_status, format_seconds, run_logged, shell_join};
-use crate::Error;
+use super::process::{Cancel, Exit, describe_status, format_seconds, run_logged, shell_join};
+use crate::error::{Error, Field, Hint};
 use std::ffi::OsString;
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -33,6 +33,8 @@ pub struct Run<'a> {
     /// The script's own arguments (after `--` for a `blender` binary; `sys.argv[1:]` for bpy).
     pub args: Vec<OsString>,
     pub timeout: Duration,
+    /// Stops the run when requested.
+    pub cancel: Cancel,
     /// Where stdout and stderr go (created or truncated); it exists afterwards, whatever
     /// happened.
     pub log: PathBuf,
@@ -88,7 +90,7 @@ pub fn command_line(run: &Run) -> String {
 pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
     let argv = argv(run);
     let command = shell_join(&argv);
-    let fail = |message: String| Error::Blender {
+    let fail = |message: Hint| Error::Blender {
         message,
         log: Some(run.log.clone()),
         command: Some(command.clone()),
@@ -98,11 +100,11 @@ pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
         message: e.to_string(),
     })?;
     let start = Instant::now();
-    let exit = run_logged(&argv, &log, run.timeout).map_err(|e| {
-        fail(format!(
+    let exit = run_logged(&argv, &log, run.timeout, &run.cancel).map_err(|e| {
+        fail(Hint::text(format!(
             "cannot start {}: {e}",
             run.blender.program.display()
-        ))
+        )))
     })?;
     let seconds = start.elapsed().as_secs_f64();
     drop(log);
@@ -113,9 +115,12 @@ pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
             });
         }
         Exit::TimedOut => {
-            return Err(fail(format!(
-                "Blender timed out after {} s (--timeout)",
-                format_seconds(run.timeout)
+            return Err(fail(Hint::new(
+                format!(
+                    "Blender timed out after {} s ({{}})",
+                    format_seconds(run.timeout)
+                ),
+                [Field::Timeout],
             )));
         }
         Exit::Finished(status) => status,
@@ -125,7 +130,7 @@ pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
         source: e,
     })?;
     let text = String::from_utf8_lossy(&bytes);
-    let result = check_output(&text, status).map_err(fail)?;
+    let result = check_output(&text, status).map_err(|m| fail(Hint::text(m)))?;
     Ok(RunOutput {
         result,
         log: run.log.clone(),

@@ -7,6 +7,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::time::Duration;
 
+use gloffuse::Field;
 use gloffuse::bench::BenchOptions;
 use gloffuse::blender::{BlenderOptions, InstallerOutput};
 use gloffuse::fit::{Point, Target, Weighting};
@@ -495,6 +496,7 @@ impl BlenderArgs {
                 InstallerOutput::Stderr
             },
             timeout: Duration::from_secs(self.timeout),
+            cancel: super::cancel().clone(),
         }
     }
 }
@@ -876,6 +878,7 @@ mod tests {
             VerifyOptions {
                 blender: BlenderOptions {
                     installer_output: InstallerOutput::Stderr,
+                    cancel: super::super::cancel().clone(),
                     ..BlenderOptions::default()
                 },
                 ..VerifyOptions::default()
@@ -890,6 +893,7 @@ mod tests {
             RefreshOptions {
                 blender: BlenderOptions {
                     installer_output: InstallerOutput::Stderr,
+                    cancel: super::super::cancel().clone(),
                     ..BlenderOptions::default()
                 },
                 ..RefreshOptions::default()
@@ -978,4 +982,44 @@ mod tests {
         }
         assert!(checked > 40, "only {checked} flags found");
     }
+}
+
+/// The flag that sets a library input: how the CLI names a [`Field`] in messages. A field no
+/// flag sets (a combination of inputs, a model's own parameter) keeps its own name.
+pub fn flag(field: Field) -> String {
+    let flag = match field {
+        Field::Blender => "--blender",
+        Field::BlenderVersion => "--blender-version",
+        Field::Blend => "--blend",
+        Field::Coefficients => "--coefficients",
+        Field::Color => "--color",
+        Field::Degree => "--degree",
+        Field::Distribution => "--distribution",
+        Field::Engine => "--engine",
+        Field::Extension => "--extension",
+        Field::Format => "--format",
+        Field::GModel => "--g-model",
+        Field::Into => "--into",
+        Field::Ior => "--ior",
+        Field::Kind => "--kind",
+        Field::Method => "--method",
+        Field::Mode => "--mode",
+        Field::Model => "--model",
+        Field::NoProvision => "--no-provision",
+        Field::Out => "--out",
+        Field::Point => "--point",
+        Field::Report => "--report",
+        Field::Roughness => "--roughness",
+        Field::Samples => "--samples",
+        Field::Script => "--script",
+        Field::Size => "--size",
+        Field::Timeout => "--timeout",
+        Field::ViewCosine => "--mu",
+        Field::Arguments
+        | Field::ContactSheet
+        | Field::ModelParameter(_)
+        | Field::PointRoughness
+        | Field::PointPercent => return field.name(),
+    };
+    flag.to_string()
 }

@@ -13,9 +13,11 @@ use serde_json::json;
 use std::io::{self, Write};
 use std::path::Path;
 use std::process::ExitCode;
+use std::sync::OnceLock;
 
 use args::{AlbedoArgs, Cli, CoefficientsCommand, Command, FitArgs};
-use gloffuse::Error;
+use gloffuse::blender::Cancel;
+use gloffuse::{Error, Field};
 use gloffuse::fit::coefficients::{INTEGRATOR_DEGREE, PRESETS, today};
 use gloffuse::fit::{Coefficients, POINTS_DEGREE, fit_points};
 use gloffuse::measure::brdf::{Model, model_albedo, model_average_albedo};
@@ -52,15 +54,19 @@ impl From<io::Error> for Failure {
 
 type Result<T> = std::result::Result<T, Failure>;
 
+/// What Ctrl-C stops: every command's Blender options carry a clone of it.
+static CANCEL: OnceLock<Cancel> = OnceLock::new();
+
+fn cancel() -> &'static Cancel {
+    CANCEL.get_or_init(Cancel::default)
+}
+
 /// Ctrl-C: while a Blender run is waited for, ask the library to stop it (the run then
 /// fails with `Error::Interrupted`, nothing is written, and `main` exits 130); otherwise end
-/// at once. Only async-signal-safe calls here.
+/// at once. Only async-signal-safe calls here (`main` made the handle before installing this).
 extern "C" fn on_interrupt(_: libc::c_int) {
-    use gloffuse::blender::process::{CHILD_RUNNING, INTERRUPTED};
-    use std::sync::atomic::Ordering;
-    if CHILD_RUNNING.load(Ordering::SeqCst) {
-        INTERRUPTED.store(true, Ordering::SeqCst);
-    } else {
+    // With a child waited for, its wait loop stops it and the command ends with 130.
+    if !CANCEL.get().is_some_and(Cancel::request) {
         let message = b"\ngloffuse: interrupted; nothing was written\n";
         // SAFETY: write and _exit are async-signal-safe.
         unsafe {
@@ -71,6 +77,7 @@ extern "C" fn on_interrupt(_: libc::c_int) {
 }
 
 pub fn main() -> ExitCode {
+    cancel();
     // SAFETY: installs a handler that only touches atomics and calls write/_exit.
     unsafe {
         libc::signal(
@@ -103,10 +110,11 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// An error and every error that caused it, joined by `: ` (the chain in full).
-fn chain(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
+/// An error, its fields named by their flags, and every error that caused it, joined by
+/// `: ` (the chain in full).
+fn chain(e: &Error) -> String {
+    let mut text = e.render(args::flag);
+    let mut cause = std::error::Error::source(e);
     while let Some(c) = cause {
         text.push_str(&format!(": {c}"));
         cause = c.source();
@@ -262,7 +270,7 @@ fn albedo(a: &AlbedoArgs, out: &mut dyn Write) -> Result<Outcome> {
     }
     let roughness = a.roughness.ok_or_else(|| {
         Error::input(
-            "arguments",
+            Field::Arguments,
             "(none)",
             "--roughness R (0 to 1), or --table FILE for a grid",
         )
@@ -341,8 +349,8 @@ fn fit(f: &FitArgs, out: &mut dyn Write) -> Result<Outcome> {
     let coefficients = if f.from.is_some() {
         if let Some(d) = f.distribution {
             return Err(Error::input(
-                "--distribution",
-                &d.to_string(),
+                Field::Distribution,
+                d,
                 "nothing with --from integrator (it fits all three distributions)",
             )
             .into());
@@ -358,14 +366,14 @@ fn fit(f: &FitArgs, out: &mut dyn Write) -> Result<Outcome> {
     } else {
         let d = f.distribution.ok_or_else(|| {
             Error::input(
-                "arguments",
+                Field::Arguments,
                 "(no --distribution)",
                 "--distribution D with --point R:PERCENT values, or --from integrator",
             )
         })?;
         if f.points.is_empty() {
             return Err(Error::input(
-                "arguments",
+                Field::Arguments,
                 "(no --point)",
                 "at least one --point ROUGHNESS:PERCENT (e.g. --point 0.5:97 --point 1:71), or --from integrator",
             )

@@ -24,6 +24,10 @@ impl Terminal {
 }
 
 impl Progress for Terminal {
+    fn advise(&self, hint: &gloffuse::Hint) {
+        self.notice(&hint.render(super::args::flag));
+    }
+
     fn notice(&self, message: &str) {
         let line = format!("gloffuse: {message}");
         match self.bar.lock().ok().and_then(|g| g.clone()) {

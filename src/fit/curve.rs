@@ -4,7 +4,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use crate::Error;
+use crate::error::{Error, Field};
 
 /// Highest polynomial degree a fit may use.
 pub const MAX_DEGREE: usize = 8;
@@ -126,9 +126,9 @@ impl std::str::FromStr for Point {
     fn from_str(s: &str) -> Result<Self, Error> {
         let bad = |why: &str| {
             Error::input(
-                "point",
+                Field::Point,
                 s,
-                &format!(
+                format!(
                     "ROUGHNESS:PERCENT with roughness in [0, 1] and a brightness above 0, e.g. 0.5:97 ({why})"
                 ),
             )
@@ -207,9 +207,9 @@ pub fn fit_polynomial(
     };
     if degree < min_degree || degree > MAX_DEGREE {
         return Err(Error::input(
-            "degree",
-            &degree.to_string(),
-            &format!("a degree from {min_degree} to {MAX_DEGREE}"),
+            Field::Degree,
+            degree,
+            format!("a degree from {min_degree} to {MAX_DEGREE}"),
         ));
     }
     check_points(points)?;
@@ -273,15 +273,15 @@ fn check_points(points: &[Point]) -> Result<(), Error> {
     for (i, p) in points.iter().enumerate() {
         if !p.roughness.is_finite() || !(0.0..=1.0).contains(&p.roughness) {
             return Err(Error::input(
-                "point roughness",
-                &p.roughness.to_string(),
+                Field::PointRoughness,
+                p.roughness,
                 "a number from 0 to 1",
             ));
         }
         if !p.percent.is_finite() || p.percent <= 0.0 {
             return Err(Error::input(
-                "point percent",
-                &p.percent.to_string(),
+                Field::PointPercent,
+                p.percent,
                 "a finite brightness above 0",
             ));
         }

@@ -8,7 +8,7 @@ use std::io::{Cursor, Write};
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
 
-use crate::Error;
+use crate::error::{Error, Field, Hint};
 use crate::measure::BlenderVersion;
 
 /// The first Blender with extensions.
@@ -55,10 +55,13 @@ copyright = ["2026 The gloffuse authors"]
 pub fn can_build(built_with: BlenderVersion) -> Result<(), Error> {
     if built_with < FIRST_BLENDER {
         return Err(Error::input(
-            "--blender",
-            &format!("Blender {}.{}", built_with.major, built_with.minor),
-            "Blender 4.2 or later for --extension (extensions came with 4.2, and the \
-             library it packs is saved by the Blender that builds it)",
+            Field::Blender,
+            format!("Blender {}.{}", built_with.major, built_with.minor),
+            Hint::new(
+                "Blender 4.2 or later for {} (extensions came with 4.2, and the library it \
+                 packs is saved by the Blender that builds it)",
+                [Field::Extension],
+            ),
         ));
     }
     Ok(())

@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use crate::Error;
+use crate::error::{Error, Field, Hint};
 use crate::blender::{BlenderOptions, Run, command_line, run_script};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
@@ -84,9 +84,12 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
         .all(|o| o.is_none())
     {
         return Err(Error::input(
-            "arguments",
+            Field::Arguments,
             "(no output)",
-            "--script OUT.py, --blend OUT.blend, --into EXISTING.blend or --extension OUT.zip",
+            Hint::new(
+                "{} OUT.py, {} OUT.blend, {} EXISTING.blend or {} OUT.zip",
+                [Field::Script, Field::Blend, Field::Into, Field::Extension],
+            ),
         ));
     }
     if let Some(into) = &g.into {
@@ -98,18 +101,23 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
             None
         };
         if let Some(expected) = expected {
-            return Err(Error::input(
-                "--into",
-                &into.display().to_string(),
-                expected,
-            ));
+            return Err(Error::input(Field::Into, into.display(), expected));
         }
         if g.blend.is_some() || g.extension.is_some() {
             return Err(Error::input(
-                "--into",
-                &into.display().to_string(),
-                "--into alone (with --script at most): --blend and --extension make a new \
-                 library, --into changes your file in place",
+                Field::Into,
+                into.display(),
+                Hint::new(
+                    "{} alone (with {} at most): {} and {} make a new library, {} changes \
+                     your file in place",
+                    [
+                        Field::Into,
+                        Field::Script,
+                        Field::Blend,
+                        Field::Extension,
+                        Field::Into,
+                    ],
+                ),
             ));
         }
     }
@@ -124,8 +132,8 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
             )
         {
             return Err(Error::input(
-                "--extension",
-                &zip.display().to_string(),
+                Field::Extension,
+                zip.display(),
                 "a file name ending in .zip (Blender installs extensions from a .zip)",
             ));
         }
@@ -155,12 +163,16 @@ fn engines_of(
     }
     let asked: Vec<&str> = g.engines.iter().map(|e| e.key()).collect();
     Err(Error::input(
-        "--engine",
-        &asked.join(","),
-        &format!(
-            "{} alone: the coefficients '{name}' correct {}'s Glossy (leave out --coefficients to build every engine's groups from the presets)",
-            engine.key(),
-            engine.label()
+        Field::Engine,
+        asked.join(","),
+        Hint::new(
+            format!(
+                "{} alone: the coefficients '{name}' correct {}'s Glossy (leave out {{}} to \
+                 build every engine's groups from the presets)",
+                engine.key(),
+                engine.label()
+            ),
+            [Field::Coefficients],
         ),
     ))
 }
@@ -279,12 +291,13 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         script: &script_path,
         args,
         timeout: g.blender.timeout,
+        cancel: g.blender.cancel.clone(),
         log: log.clone(),
     };
     run_script(&run)?;
     if let Some(why) = incomplete_blend(&tmp) {
         return Err(Error::Blender {
-            message: format!("Blender reported success but {why}"),
+            message: format!("Blender reported success but {why}").into(),
             log: Some(log),
             command: Some(command_line(&run)),
         });

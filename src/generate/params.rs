@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use super::catalogs::Catalogs;
-use crate::Error;
+use crate::error::{Error, Field};
 use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
 use crate::measure::{
     AlbedoIntegrator, BlenderVersion, Distribution, Engine, Masking, Roughness, coat,
@@ -327,7 +327,7 @@ impl GenerateParams {
         };
         if engines.contains(&Engine::Eevee) && modes.contains(&Mode::Layered) {
             return Err(Error::input(
-                "--mode",
+                Field::Mode,
                 Mode::Layered.key(),
                 "roughness, view or multiscatter for EEVEE: the layered groups are calibrated \
                  and checked in Cycles only",

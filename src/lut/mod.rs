@@ -52,7 +52,7 @@ pub mod split_sum;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::Error;
+use crate::error::{Error, Field, Hint};
 use crate::measure::{BlenderVersion, Distribution};
 use crate::output::{check_destination, write_output};
 use crate::progress::Progress;
@@ -302,26 +302,29 @@ impl Spec {
         let samples = args.samples.unwrap_or(default_samples);
         if size == 0 || size > MAX_SIZE {
             return Err(Error::input(
-                "--size",
-                &size.to_string(),
-                &format!("texels per side from 1 to {MAX_SIZE}"),
+                Field::Size,
+                size,
+                format!("texels per side from 1 to {MAX_SIZE}"),
             ));
         }
         if samples == 0 || samples > MAX_SAMPLES {
             return Err(Error::input(
-                "--samples",
-                &samples.to_string(),
-                &format!("samples per texel from 1 to {MAX_SAMPLES}"),
+                Field::Samples,
+                samples,
+                format!("samples per texel from 1 to {MAX_SAMPLES}"),
             ));
         }
         if args.kind == Kind::Coat && size > coat::MAX_SIZE {
             return Err(Error::input(
-                "--size",
-                &size.to_string(),
-                &format!(
-                    "texels per slice side from 1 to {} for --kind coat (its atlas is {} slices wide)",
-                    coat::MAX_SIZE,
-                    crate::measure::coat::SLICES
+                Field::Size,
+                size,
+                Hint::new(
+                    format!(
+                        "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
+                        coat::MAX_SIZE,
+                        crate::measure::coat::SLICES
+                    ),
+                    [Field::Kind],
                 ),
             ));
         }
@@ -330,25 +333,34 @@ impl Spec {
             Kind::SplitSum => {
                 if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
                     return Err(Error::input(
-                        "--distribution",
+                        Field::Distribution,
                         d.key(),
-                        "ggx or nothing: the split-sum table is GGX by definition (use --kind kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
+                        Hint::new(
+                            "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
+                            [Field::Kind],
+                        ),
                     ));
                 }
                 if let Some(v) = args.blender_version {
                     return Err(Error::input(
-                        "--blender-version",
-                        &v.to_string(),
-                        "nothing with --kind split-sum (choose its masking with --g-model; --blender-version applies to kulla-conty)",
+                        Field::BlenderVersion,
+                        v,
+                        Hint::new(
+                            "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
+                            [Field::Kind, Field::GModel, Field::BlenderVersion],
+                        ),
                     ));
                 }
                 let estimate = match args.method.unwrap_or(Method::Quadrature) {
                     Method::Quadrature => {
                         if let Some(n) = args.samples {
                             return Err(Error::input(
-                                "--samples",
-                                &n.to_string(),
-                                "nothing with --kind split-sum's default --method quadrature (it is deterministic quadrature, not sampled; --samples applies to --method classic)",
+                                Field::Samples,
+                                n,
+                                Hint::new(
+                                    "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
+                                    [Field::Kind, Field::Method, Field::Samples, Field::Method],
+                                ),
                             ));
                         }
                         split_sum::Estimate::Quadrature(split_sum::Rule::default())
@@ -365,18 +377,24 @@ impl Spec {
                 let kind = args.kind.key();
                 if let Some(g) = args.g_model {
                     return Err(Error::input(
-                        "--g-model",
+                        Field::GModel,
                         g.key(),
-                        &format!(
-                            "nothing with --kind {kind} (its masking follows --blender-version; --g-model applies to split-sum)"
+                        Hint::new(
+                            format!(
+                                "nothing with {{}} {kind} (its masking follows {{}}; {{}} applies to split-sum)"
+                            ),
+                            [Field::Kind, Field::BlenderVersion, Field::GModel],
                         ),
                     ));
                 }
                 if let Some(m) = args.method {
                     return Err(Error::input(
-                        "--method",
+                        Field::Method,
                         m.key(),
-                        &format!("nothing with --kind {kind} (--method applies to split-sum)"),
+                        Hint::new(
+                            format!("nothing with {{}} {kind} ({{}} applies to split-sum)"),
+                            [Field::Kind, Field::Method],
+                        ),
                     ));
                 }
                 let distribution = args.distribution.unwrap_or(Distribution::Ggx);
@@ -391,10 +409,13 @@ impl Spec {
                 }
                 if let Some(n) = args.samples {
                     return Err(Error::input(
-                        "--samples",
-                        &n.to_string(),
-                        &format!(
-                            "nothing with --kind {kind} (it is integrated by deterministic quadrature, not sampled)"
+                        Field::Samples,
+                        n,
+                        Hint::new(
+                            format!(
+                                "nothing with {{}} {kind} (it is integrated by deterministic quadrature, not sampled)"
+                            ),
+                            [Field::Kind],
                         ),
                     ));
                 }
@@ -518,9 +539,12 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         Some(f) => f,
         None => Format::from_path(&args.out).ok_or_else(|| {
             Error::input(
-                "--out",
-                &args.out.display().to_string(),
-                "a file name ending in .exr, .dds or .ktx2 (or give --format exr|dds|ktx)",
+                Field::Out,
+                args.out.display(),
+                Hint::new(
+                    "a file name ending in .exr, .dds or .ktx2 (or give {} exr|dds|ktx)",
+                    [Field::Format],
+                ),
             )
         })?,
     };

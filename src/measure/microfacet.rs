@@ -10,7 +10,7 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use crate::Error;
+use crate::error::{Error, Field};
 
 /// The three single-scattering distributions of Blender's Glossy BSDF.
 #[derive(
@@ -75,7 +75,7 @@ impl std::str::FromStr for Distribution {
             .find(|d| d.key() == norm)
             .ok_or_else(|| {
                 Error::input(
-                    "distribution",
+                    Field::Distribution,
                     s,
                     "one of beckmann, ggx, ashikhmin-shirley (case-insensitive; Blender's BECKMANN, GGX, ASHIKHMIN_SHIRLEY also work)",
                 )
@@ -122,8 +122,8 @@ impl Roughness {
             Ok(Roughness(value))
         } else {
             Err(Error::input(
-                "roughness",
-                &value.to_string(),
+                Field::Roughness,
+                value,
                 "a number from 0 to 1 (the Glossy node's Roughness range)",
             ))
         }
@@ -166,7 +166,7 @@ impl std::str::FromStr for Roughness {
         let v: f64 = s
             .trim()
             .parse()
-            .map_err(|_| Error::input("roughness", s, "a number from 0 to 1, for example 0.5"))?;
+            .map_err(|_| Error::input(Field::Roughness, s, "a number from 0 to 1, for example 0.5"))?;
         Roughness::new(v)
     }
 }

@@ -2,7 +2,7 @@
 //! of each version's Cycles.
 
 use super::microfacet::Masking;
-use crate::Error;
+use crate::error::{Error, Field};
 
 /// A Blender release, `major.minor` (a patch number is accepted and ignored).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -47,7 +47,7 @@ impl std::str::FromStr for BlenderVersion {
     fn from_str(s: &str) -> Result<Self, Error> {
         let bad = || {
             Error::input(
-                "Blender version",
+                Field::BlenderVersion,
                 s,
                 "a version like 3.4, 4.5 or 5.0 (3.0 or later)",
             )
@@ -67,7 +67,7 @@ impl std::str::FromStr for BlenderVersion {
         let v = BlenderVersion { major, minor };
         if v < Self::OLDEST {
             return Err(Error::input(
-                "Blender version",
+                Field::BlenderVersion,
                 s,
                 "Blender 3.0 or later (older Glossy BSDFs are not modelled)",
             ));

@@ -13,7 +13,7 @@ use plotters::backend::RGBPixel;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::Error;
+use crate::error::{Error, Field};
 use crate::generate::Mode;
 use crate::measure::Distribution;
 use crate::output::write_output;
@@ -103,7 +103,7 @@ pub fn contact_sheet(
     column_labels: &[String],
     out: &Path,
 ) -> Result<(), Error> {
-    let geometry = |value: String, expected: &str| Error::input("contact sheet", &value, expected);
+    let geometry = |value: String, expected: &str| Error::input(Field::ContactSheet, value, expected);
     if cell == 0 || image.width == 0 || image.height == 0 {
         return Err(geometry(
             format!("{}×{} image, cell {cell}", image.width, image.height),

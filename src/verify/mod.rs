@@ -13,7 +13,7 @@ pub use plan::{Plan, RenderSettings, Role};
 pub use render::{RenderInfo, Rendered, render};
 pub use verdict::{Judging, ReferenceSphere, Row, Sweep, VerifyReport};
 
-use crate::Error;
+use crate::error::{Error, Field, Hint};
 use crate::blender::{Blender, BlenderOptions};
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
@@ -125,7 +125,7 @@ pub fn verify_with(
         &groups,
         v.mode,
         v.color,
-        v.blender.timeout,
+        &v.blender,
         progress,
     )?;
     let sweep = Sweep {
@@ -146,9 +146,13 @@ pub fn verify_with(
 fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
     if engine == Engine::Eevee && mode == Mode::Layered {
         return Err(Error::input(
-            "--engine",
+            Field::Engine,
             engine.key(),
-            "cycles with --mode layered (the layered groups are calibrated and checked in Cycles only)",
+            Hint::new(
+                "cycles with {} layered (the layered groups are calibrated and checked in \
+                 Cycles only)",
+                [Field::Mode],
+            ),
         ));
     }
     Ok(())
@@ -161,8 +165,8 @@ pub fn check_color(color: [f64; 3]) -> Result<(), Error> {
     }
     let text: Vec<String> = color.iter().map(|c| c.to_string()).collect();
     Err(Error::input(
-        "--color",
-        &text.join(","),
+        Field::Color,
+        text.join(","),
         "three linear values from 0 to 1, e.g. 0.95,0.64,0.54",
     ))
 }
@@ -173,27 +177,33 @@ fn check_ior(mode: Mode, ior: &[f64]) -> Result<(), Error> {
     if mode != Mode::Layered {
         return match ior.first() {
             Some(n) => Err(Error::input(
-                "--ior",
-                &n.to_string(),
-                "no index of refraction: --ior goes with --mode layered",
+                Field::Ior,
+                n,
+                Hint::new(
+                    "no index of refraction: {} goes with {} layered",
+                    [Field::Ior, Field::Mode],
+                ),
             )),
             None => Ok(()),
         };
     }
     if ior.is_empty() {
         return Err(Error::input(
-            "--ior",
+            Field::Ior,
             "",
-            "at least one index of refraction for --mode layered",
+            Hint::new(
+                "at least one index of refraction for {} layered",
+                [Field::Mode],
+            ),
         ));
     }
     for (i, n) in ior.iter().enumerate() {
         let range = 1.0..=coat::IOR_MAX;
         if !range.contains(n) || ior[..i].contains(n) {
             return Err(Error::input(
-                "--ior",
-                &n.to_string(),
-                &format!("each index once, from 1 to {}", coat::IOR_MAX),
+                Field::Ior,
+                n,
+                format!("each index once, from 1 to {}", coat::IOR_MAX),
             ));
         }
     }
@@ -204,8 +214,8 @@ fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {
     for (i, r) in roughness.iter().enumerate() {
         if roughness[..i].contains(r) {
             return Err(Error::input(
-                "--roughness",
-                &r.get().to_string(),
+                Field::Roughness,
+                r.get(),
                 "each roughness once",
             ));
         }
@@ -227,9 +237,9 @@ fn distributions_of(
         if !coefficients.distributions.contains_key(d) {
             let have: Vec<_> = coefficients.distributions.keys().map(|d| d.key()).collect();
             return Err(Error::input(
-                "--distribution",
+                Field::Distribution,
                 d.key(),
-                &format!("one the coefficients '{source}' hold: {}", have.join(", ")),
+                format!("one the coefficients '{source}' hold: {}", have.join(", ")),
             ));
         }
     }

@@ -8,7 +8,7 @@ use super::image::{Rgba, read_rgba};
 use super::plan::Plan;
 use super::stats::{SphereStats, sphere_stats};
 use crate::Error;
-use crate::blender::{Blender, Run, command_line, run_script, runs};
+use crate::blender::{Blender, BlenderOptions, Run, command_line, run_script, runs};
 use crate::generate::{GenerateParams, Job, Mode, assemble};
 use crate::output::write_output;
 use crate::progress::Progress;
@@ -47,7 +47,7 @@ pub fn render(
     groups: &GenerateParams,
     mode: Mode,
     color: [f64; 3],
-    timeout: Duration,
+    options: &BlenderOptions,
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     let run_dir = runs::new_run_dir("verify")?;
@@ -60,7 +60,8 @@ pub fn render(
         blender,
         script: &script,
         args: Vec::new(),
-        timeout,
+        timeout: options.timeout,
+        cancel: options.cancel.clone(),
         log: log.clone(),
     };
     let command = command_line(&run);
@@ -91,7 +92,7 @@ pub fn render(
     progress.end();
     let out = outcome?;
     let image = read_rgba(&exr).map_err(|e| Error::Blender {
-        message: e.to_string(),
+        message: e.to_string().into(),
         log: Some(log.clone()),
         command: Some(command.clone()),
     })?;
@@ -106,7 +107,8 @@ pub fn render(
                 image.height,
                 want.0,
                 want.1
-            ),
+            )
+            .into(),
             log: Some(log),
             command: Some(command),
         });

@@ -87,6 +87,7 @@ pub fn run_in_blender(
         script,
         args: args.iter().map(|a| a.to_os_string()).collect(),
         timeout: std::time::Duration::from_secs(600),
+        cancel: Default::default(),
         log: PathBuf::new(),
     });
     std::process::Command::new(&argv[0])

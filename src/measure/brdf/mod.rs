@@ -23,7 +23,7 @@ pub use ward::Ward;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use crate::Error;
+use crate::error::{Error, Field};
 
 /// A reflection-only BRDF in the local shading frame, with a sampler and its pdf.
 pub trait Brdf {
@@ -148,7 +148,7 @@ impl std::str::FromStr for Model {
             .find(|m| m.key() == norm)
             .ok_or_else(|| {
                 Error::input(
-                    "model",
+                    Field::Model,
                     s,
                     "one of lambert, phong, ward, cook-torrance, fresnel-blend (case-insensitive)",
                 )
@@ -204,8 +204,8 @@ impl Default for ModelParams {
 pub fn model_albedo(model: Model, params: &ModelParams, mu: f64) -> Result<f64, Error> {
     if !(mu > 0.0 && mu <= 1.0) {
         return Err(Error::input(
-            "view cosine mu",
-            &mu.to_string(),
+            Field::ViewCosine,
+            mu,
             "a number in (0, 1]",
         ));
     }
@@ -225,26 +225,26 @@ pub fn model_average_albedo(model: Model, params: &ModelParams) -> Result<f64, E
 }
 
 /// A reflectance: finite, in [0, 1].
-fn reflectance(what: &str, value: f64) -> Result<f64, Error> {
+fn reflectance(what: &'static str, value: f64) -> Result<f64, Error> {
     if (0.0..=1.0).contains(&value) {
         Ok(value)
     } else {
         Err(Error::input(
-            what,
-            &value.to_string(),
+            Field::ModelParameter(what),
+            value,
             "a number from 0 to 1",
         ))
     }
 }
 
 /// A lobe width α: finite and > 0.
-fn width(what: &str, value: f64) -> Result<f64, Error> {
+fn width(what: &'static str, value: f64) -> Result<f64, Error> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
         Err(Error::input(
-            what,
-            &value.to_string(),
+            Field::ModelParameter(what),
+            value,
             "a finite number > 0",
         ))
     }
