@@ -142,6 +142,8 @@ pub enum Field {
     Into,
     /// Indices of refraction.
     Ior,
+    /// Where a fit's points come from (the integrator, rather than points given).
+    FitSource,
     /// Which lookup table.
     Kind,
     /// How a split-sum table is integrated.
@@ -168,6 +170,8 @@ pub enum Field {
     Script,
     /// Texels per side.
     Size,
+    /// The CSV file for a grid of albedos.
+    Table,
     /// How long Blender may run.
     Timeout,
     /// A view cosine μ.
@@ -193,6 +197,7 @@ impl Field {
             Field::GModel => "masking model",
             Field::Into => "file to update",
             Field::Ior => "index of refraction",
+            Field::FitSource => "fit source",
             Field::Kind => "table kind",
             Field::Method => "method",
             Field::Mode => "mode",
@@ -208,6 +213,7 @@ impl Field {
             Field::Samples => "samples",
             Field::Script => "script",
             Field::Size => "size",
+            Field::Table => "albedo table",
             Field::Timeout => "timeout",
             Field::ViewCosine => "view cosine mu",
         }
@@ -315,4 +321,61 @@ pub enum ExrError {
         channel: &'static str,
         found: String,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn flags(field: Field) -> String {
+        format!("--{}", field.name().replace(' ', "-"))
+    }
+
+    #[test]
+    fn a_hint_names_each_field_as_the_caller_says() {
+        let hint = Hint::new(
+            "nothing with {} split-sum ({} applies)",
+            [Field::Kind, Field::Method],
+        );
+        assert_eq!(
+            hint.to_string(),
+            "nothing with table kind split-sum (method applies)"
+        );
+        assert_eq!(
+            hint.render(flags),
+            "nothing with --table-kind split-sum (--method applies)"
+        );
+    }
+
+    #[test]
+    fn text_from_elsewhere_is_taken_as_it_is() {
+        let hint = Hint::text("a path {} with braces").then(Hint::new(" see {}", [Field::Out]));
+        assert_eq!(hint.render(flags), "a path {} with braces see --output");
+    }
+
+    #[test]
+    fn an_input_error_names_its_field_and_what_was_expected() {
+        let e = Error::input(Field::Ior, 1.5, Hint::new("{} layered", [Field::Mode]));
+        assert_eq!(
+            e.to_string(),
+            "invalid index of refraction '1.5': expected mode layered"
+        );
+        assert_eq!(
+            e.render(flags),
+            "invalid --index-of-refraction '1.5': expected --mode layered"
+        );
+    }
+
+    #[test]
+    fn a_blender_error_keeps_its_log_and_command_after_the_message() {
+        let e = Error::Blender {
+            message: Hint::new("timed out ({})", [Field::Timeout]),
+            log: Some(PathBuf::from("/tmp/x.log")),
+            command: Some("blender -b".into()),
+        };
+        assert_eq!(
+            e.render(flags),
+            "timed out (--timeout); log: /tmp/x.log; command: blender -b"
+        );
+    }
 }

@@ -7,6 +7,7 @@
 //! [`blender`] runs Blender. The library returns data and never prints: long work reports
 //! through [`progress::Progress`]. See `docs/ARCHITECTURE.md`.
 
+pub mod albedo;
 pub mod bench;
 pub mod blender;
 pub mod error;

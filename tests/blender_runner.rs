@@ -143,6 +143,28 @@ exit 1"#,
 }
 
 #[test]
+fn a_cancel_passed_in_stops_the_run_and_only_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let blender = blender_running(dir.path(), "sleep 1000");
+    let script = dir.path().join("hang.py");
+    let mut run = run_of(&blender, &script, dir.path(), 600);
+    let cancel = gloffuse::blender::Cancel::default();
+    run.cancel = cancel.clone();
+    let other = gloffuse::blender::Cancel::default();
+    let start = Instant::now();
+    let stopper = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(500));
+        // Nothing waits on `other`; the run waits on `cancel`.
+        (other.request(), cancel.request())
+    });
+    let err = run_script(&run).unwrap_err();
+    let took = start.elapsed();
+    assert_eq!(stopper.join().unwrap(), (false, true));
+    assert!(matches!(err, Error::Interrupted { .. }), "{err:?}");
+    assert!(took < Duration::from_secs(10), "{took:?}");
+}
+
+#[test]
 fn a_hang_is_killed_with_its_whole_process_group() {
     let dir = tempfile::tempdir().unwrap();
     let pids = dir.path().display().to_string();
@@ -306,9 +328,9 @@ fn explicit_paths_are_used_or_refused_never_passed_over() {
     let missing = dir.path().join("no/such/blender");
     let err = find(&missing).unwrap_err();
     assert!(matches!(err, Error::BlenderNotFound(_)), "{err:?}");
-    let shown = err.to_string();
+    let shown = err.render(|f| format!("<{f:?}>"));
     assert!(
-        shown.contains("--blender") && shown.contains(&missing.display().to_string()),
+        shown.starts_with("<Blender> ") && shown.contains(&missing.display().to_string()),
         "{shown}"
     );
 

@@ -274,7 +274,7 @@ const BAD_INPUT: &[(&[&str], &str)] = &[
         &[
             "fit", "-d", "ggx", "-p", "0.5:85", "-p", "1:59", "--degree", "9",
         ],
-        "invalid degree '9'",
+        "invalid --degree '9'",
     ),
     (&["fit", "-p", "0.5:85", "-p", "1:59"], "--distribution"),
     (

@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use gloffuse::Field;
+use gloffuse::albedo::AlbedoOptions;
 use gloffuse::bench::BenchOptions;
 use gloffuse::blender::{BlenderOptions, InstallerOutput};
-use gloffuse::fit::{Point, Target, Weighting};
+use gloffuse::fit::{FitOptions, Point, Target, Weighting};
 use gloffuse::generate::{ColorModel, GenerateOptions, Mode};
 use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Method};
 use gloffuse::measure::brdf::{Model, ModelParams};
@@ -409,13 +410,38 @@ pub struct AlbedoArgs {
 }
 
 impl AlbedoArgs {
-    pub fn model_params(&self) -> ModelParams {
-        ModelParams {
-            rho: self.rho,
-            rs: self.rs,
-            exponent: self.exponent,
-            alpha_x: self.alpha_x,
-            alpha_y: self.alpha_y,
+    pub fn options(&self) -> AlbedoOptions {
+        AlbedoOptions {
+            distribution: self.distribution,
+            model: self.model,
+            params: ModelParams {
+                rho: self.rho,
+                rs: self.rs,
+                exponent: self.exponent,
+                alpha_x: self.alpha_x,
+                alpha_y: self.alpha_y,
+            },
+            roughness: self.roughness,
+            mu: self.mu,
+            blender_version: self.blender_version,
+            table: self.table.clone(),
+            grid: self.grid as usize,
+        }
+    }
+}
+
+impl FitArgs {
+    pub fn options(&self) -> FitOptions {
+        FitOptions {
+            from_integrator: self.from.is_some(),
+            distribution: self.distribution,
+            points: self.points.clone(),
+            degree: self.degree,
+            weighting: self.weighting,
+            target: self.target,
+            engine: self.engine,
+            blender_version: self.blender_version,
+            out: self.out.clone(),
         }
     }
 }
@@ -1001,6 +1027,7 @@ pub fn flag(field: Field) -> String {
         Field::GModel => "--g-model",
         Field::Into => "--into",
         Field::Ior => "--ior",
+        Field::FitSource => "--from",
         Field::Kind => "--kind",
         Field::Method => "--method",
         Field::Mode => "--mode",
@@ -1013,6 +1040,7 @@ pub fn flag(field: Field) -> String {
         Field::Samples => "--samples",
         Field::Script => "--script",
         Field::Size => "--size",
+        Field::Table => "--table",
         Field::Timeout => "--timeout",
         Field::ViewCosine => "--mu",
         Field::Arguments

@@ -9,21 +9,18 @@ mod progress;
 mod text;
 
 use clap::Parser;
-use serde_json::json;
 use std::io::{self, Write};
 use std::path::Path;
 use std::process::ExitCode;
 use std::sync::OnceLock;
 
 use args::{AlbedoArgs, Cli, CoefficientsCommand, Command, FitArgs};
+use gloffuse::Error;
+use gloffuse::albedo::AlbedoOutput;
 use gloffuse::blender::Cancel;
-use gloffuse::{Error, Field};
-use gloffuse::fit::coefficients::{INTEGRATOR_DEGREE, PRESETS, today};
-use gloffuse::fit::{Coefficients, POINTS_DEGREE, fit_points};
-use gloffuse::measure::brdf::{Model, model_albedo, model_average_albedo};
-use gloffuse::measure::{AlbedoIntegrator, Glossy, Roughness};
+use gloffuse::fit::{FitSummary, Shown};
 use gloffuse::output::{check_destination, is_stdout, write_output};
-use gloffuse::progress::Quiet;
+use gloffuse::progress::Progress;
 use progress::{Terminal, eprintln_quietly};
 
 /// How a command ended, when it did not fail.
@@ -140,7 +137,7 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
     let terminal = Terminal::default();
     let mut stderr = io::stderr();
     match cli.command {
-        Command::Albedo(a) => albedo(&a, out),
+        Command::Albedo(a) => albedo(&a, out, &terminal),
         Command::Fit(f) => {
             let out = summary(out, &mut stderr, &[f.out.as_deref()]);
             fit(&f, out)
@@ -244,176 +241,35 @@ fn print_json(out: &mut dyn Write, value: &impl serde::Serialize) -> Result<()> 
     Ok(())
 }
 
-fn albedo(a: &AlbedoArgs, out: &mut dyn Write) -> Result<Outcome> {
-    if let Some(model) = a.model {
-        return albedo_of_model(a, model, out);
-    }
-    let distribution = a
-        .distribution
-        .expect("clap requires --distribution without --model");
-    let masking = a.blender_version.masking();
-    let integrator = AlbedoIntegrator::default();
-    if let Some(path) = &a.table {
-        // A bad destination fails before minutes of integration, not after.
-        check_destination(path)?;
-        let n = a.grid as usize;
-        let mus: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
-        let grid = integrator.grid(distribution, masking, &Roughness::grid(n), &mus, &Quiet);
-        write_output(path, grid.csv().as_bytes())?;
-        eprintln_quietly(&format!(
-            "wrote {} ({n}×{n} grid, {} masking, Blender {})",
-            path.display(),
+fn albedo(a: &AlbedoArgs, out: &mut dyn Write, progress: &dyn Progress) -> Result<Outcome> {
+    match gloffuse::albedo::albedo(&a.options(), progress)? {
+        AlbedoOutput::Table {
+            path,
+            grid,
             masking,
-            a.blender_version
-        ));
-        return Ok(Outcome::Success);
-    }
-    let roughness = a.roughness.ok_or_else(|| {
-        Error::input(
-            Field::Arguments,
-            "(none)",
-            "--roughness R (0 to 1), or --table FILE for a grid",
-        )
-    })?;
-    let g = Glossy::new(distribution, masking, roughness);
-    let e = integrator.directional_albedo(&g, a.mu);
-    let avg = integrator.average_albedo(&g);
-    if a.json {
-        let v = json!({
-            "distribution": distribution,
-            "roughness": roughness.get(),
-            "alpha": roughness.alpha(),
-            "mu": a.mu,
-            "blender_version": a.blender_version.to_string(),
-            "masking": masking,
-            "directional_albedo": e,
-            "average_albedo": avg,
-        });
-        print_json(out, &v)?;
-    } else {
-        writeln!(
-            out,
-            "{} roughness {} (alpha {}), Blender {} ({} masking)",
-            distribution.label(),
-            roughness.get(),
-            roughness.alpha(),
-            a.blender_version,
-            masking
-        )?;
-        writeln!(
-            out,
-            "E(mu = {}) = {e:.6}   brightness at view cosine {} ({:.2} %)",
-            a.mu,
-            a.mu,
-            100.0 * e
-        )?;
-        writeln!(
-            out,
-            "E_avg      = {avg:.6}   mean brightness of a furnace sphere ({:.2} %)",
-            100.0 * avg
-        )?;
-    }
-    Ok(Outcome::Success)
-}
-
-/// `albedo --model`: directional albedo of a classic BRDF, and its hemispherical average.
-fn albedo_of_model(a: &AlbedoArgs, model: Model, out: &mut dyn Write) -> Result<Outcome> {
-    let params = a.model_params();
-    let e = model_albedo(model, &params, a.mu)?;
-    let avg = model_average_albedo(model, &params)?;
-    if a.json {
-        let v = json!({
-            "model": format!("{model:?}"),
-            "parameters": { "rho": a.rho, "rs": a.rs, "exponent": a.exponent, "alpha_x": a.alpha_x, "alpha_y": a.alpha_y },
-            "mu": a.mu,
-            "directional_albedo": e,
-            "average_albedo": avg,
-        });
-        print_json(out, &v)?;
-    } else {
-        writeln!(
-            out,
-            "{model:?} (rho {}, rs {}, exponent {}, alpha {} × {})",
-            a.rho, a.rs, a.exponent, a.alpha_x, a.alpha_y
-        )?;
-        writeln!(out, "E(mu = {}) = {e:.6}", a.mu)?;
-        writeln!(out, "E_avg      = {avg:.6}")?;
+            blender_version,
+        } => eprintln_quietly(&format!(
+            "wrote {} ({grid}×{grid} grid, {masking} masking, Blender {blender_version})",
+            path.display()
+        )),
+        // Keys sorted, as albedo's JSON has always been.
+        AlbedoOutput::Point(albedo) => emit(out, a.json, &albedo, text::albedo)?,
     }
     Ok(Outcome::Success)
 }
 
 fn fit(f: &FitArgs, out: &mut dyn Write) -> Result<Outcome> {
-    if let Some(path) = &f.out {
-        check_destination(path)?;
-    }
-    let coefficients = if f.from.is_some() {
-        if let Some(d) = f.distribution {
-            return Err(Error::input(
-                Field::Distribution,
-                d,
-                "nothing with --from integrator (it fits all three distributions)",
-            )
-            .into());
-        }
-        Coefficients::from_integrator(
-            f.engine,
-            f.blender_version,
-            f.degree.unwrap_or(INTEGRATOR_DEGREE),
-            f.target,
-            f.weighting,
-            Some(today()),
-        )?
-    } else {
-        let d = f.distribution.ok_or_else(|| {
-            Error::input(
-                Field::Arguments,
-                "(no --distribution)",
-                "--distribution D with --point R:PERCENT values, or --from integrator",
-            )
-        })?;
-        if f.points.is_empty() {
-            return Err(Error::input(
-                Field::Arguments,
-                "(no --point)",
-                "at least one --point ROUGHNESS:PERCENT (e.g. --point 0.5:97 --point 1:71), or --from integrator",
-            )
-            .into());
-        }
-        fit_points(
-            d,
-            &f.points,
-            f.degree.unwrap_or(POINTS_DEGREE),
-            f.weighting,
-            f.target,
-            f.engine,
-            f.blender_version,
-        )?
-    };
-    if let Some(path) = &f.out {
-        coefficients.write(path)?;
+    let fitted = gloffuse::fit::fit(&f.options())?;
+    if let Some(path) = &fitted.wrote {
         eprintln_quietly(&format!("wrote {}", path.display()));
     }
     if f.json {
-        let list: Vec<_> = coefficients
-            .distributions
-            .iter()
-            .map(|(d, e)| {
-                let n = &e.curve.numerator;
-                let c = |k: usize| n.get(k).copied().unwrap_or(0.0);
-                json!({
-                    "distribution": d,
-                    "degree": e.degree,
-                    "a": c(3), "b": c(2), "c": c(1), "d": c(0),
-                    "coefficients_ascending": n,
-                    "curve": e.curve,
-                    "weighting": e.weighting,
-                    "residuals": e.residuals,
-                })
-            })
-            .collect();
-        print_json(out, &json!({ "fits": list }))?;
+        // Through a JSON value, so the keys are sorted as fit's JSON has always been.
+        let summary = serde_json::to_value(FitSummary::of(&fitted.coefficients))
+            .expect("a fit serialises to JSON");
+        print_json(out, &summary)?;
     } else {
-        for (d, e) in &coefficients.distributions {
+        for (d, e) in &fitted.coefficients.distributions {
             out.write_all(text::entry(d.label(), e).as_bytes())?;
         }
     }
@@ -421,21 +277,9 @@ fn fit(f: &FitArgs, out: &mut dyn Write) -> Result<Outcome> {
 }
 
 fn show(source: Option<&str>, json: bool, out: &mut dyn Write) -> Result<Outcome> {
-    let Some(source) = source else {
-        writeln!(out, "Built-in presets (gloffuse coefficients show NAME):")?;
-        for (name, _, summary) in PRESETS {
-            writeln!(out, "  {name:<10} {summary}")?;
-        }
-        return Ok(Outcome::Success);
-    };
-    let c = Coefficients::load(source)?;
-    if json {
-        out.write_all(c.to_json().as_bytes())?;
-        return Ok(Outcome::Success);
-    }
-    writeln!(out, "{} — {}", c.name, c.description)?;
-    for (d, e) in &c.distributions {
-        out.write_all(text::entry(d.label(), e).as_bytes())?;
+    match gloffuse::fit::show(source)? {
+        Shown::Coefficients(c) if json => out.write_all(c.to_json().as_bytes())?,
+        shown => out.write_all(text::shown(&shown).as_bytes())?,
     }
     Ok(Outcome::Success)
 }

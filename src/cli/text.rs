@@ -3,8 +3,9 @@
 
 use std::fmt::Write as _;
 
+use gloffuse::albedo::Albedo;
 use gloffuse::fit::coefficients::Entry;
-use gloffuse::fit::{ColorSpace, Curve, Target, Variable, Weighting};
+use gloffuse::fit::{ColorSpace, Curve, Shown, Target, Variable, Weighting};
 use gloffuse::generate::Generated;
 use gloffuse::lut::LutSummary;
 use gloffuse::refresh::Refreshed;
@@ -260,4 +261,73 @@ fn fmt_num_signed(v: f64) -> String {
     } else {
         fmt_num(v)
     }
+}
+
+/// What `albedo` prints for one surface.
+pub fn albedo(a: &Albedo) -> String {
+    let mut s = String::new();
+    match a {
+        Albedo::Glossy {
+            alpha,
+            average_albedo,
+            blender_version,
+            directional_albedo: e,
+            distribution,
+            masking,
+            mu,
+            roughness,
+        } => {
+            let _ = writeln!(
+                s,
+                "{} roughness {roughness} (alpha {alpha}), Blender {blender_version} ({masking} masking)",
+                distribution.label()
+            );
+            let _ = writeln!(
+                s,
+                "E(mu = {mu}) = {e:.6}   brightness at view cosine {mu} ({:.2} %)",
+                100.0 * e
+            );
+            let _ = writeln!(
+                s,
+                "E_avg      = {average_albedo:.6}   mean brightness of a furnace sphere ({:.2} %)",
+                100.0 * average_albedo
+            );
+        }
+        Albedo::Model {
+            average_albedo,
+            directional_albedo: e,
+            model,
+            mu,
+            parameters: p,
+        } => {
+            let _ = writeln!(
+                s,
+                "{model:?} (rho {}, rs {}, exponent {}, alpha {} × {})",
+                p.rho, p.rs, p.exponent, p.alpha_x, p.alpha_y
+            );
+            let _ = writeln!(s, "E(mu = {mu}) = {e:.6}");
+            let _ = writeln!(s, "E_avg      = {average_albedo:.6}");
+        }
+    }
+    s
+}
+
+/// What `coefficients show` prints: the presets, or one set of coefficients.
+pub fn shown(shown: &Shown) -> String {
+    let mut s = String::new();
+    match shown {
+        Shown::Presets(presets) => {
+            s.push_str("Built-in presets (gloffuse coefficients show NAME):\n");
+            for (name, summary) in presets {
+                let _ = writeln!(s, "  {name:<10} {summary}");
+            }
+        }
+        Shown::Coefficients(c) => {
+            let _ = writeln!(s, "{} — {}", c.name, c.description);
+            for (d, e) in &c.distributions {
+                s.push_str(&entry(d.label(), e));
+            }
+        }
+    }
+    s
 }

@@ -17,8 +17,8 @@ use serde::Serialize;
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use crate::error::{Error, Field, Hint};
 use crate::blender::{BlenderOptions, Run, command_line, run_script};
+use crate::error::{Error, Field, Hint};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
 use crate::output::{Destination, check_destination, write_output};

@@ -163,10 +163,9 @@ impl std::fmt::Display for Roughness {
 impl std::str::FromStr for Roughness {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Error> {
-        let v: f64 = s
-            .trim()
-            .parse()
-            .map_err(|_| Error::input(Field::Roughness, s, "a number from 0 to 1, for example 0.5"))?;
+        let v: f64 = s.trim().parse().map_err(|_| {
+            Error::input(Field::Roughness, s, "a number from 0 to 1, for example 0.5")
+        })?;
         Roughness::new(v)
     }
 }

@@ -103,7 +103,8 @@ pub fn contact_sheet(
     column_labels: &[String],
     out: &Path,
 ) -> Result<(), Error> {
-    let geometry = |value: String, expected: &str| Error::input(Field::ContactSheet, value, expected);
+    let geometry =
+        |value: String, expected: &str| Error::input(Field::ContactSheet, value, expected);
     if cell == 0 || image.width == 0 || image.height == 0 {
         return Err(geometry(
             format!("{}×{} image, cell {cell}", image.width, image.height),

@@ -13,8 +13,8 @@ pub use plan::{Plan, RenderSettings, Role};
 pub use render::{RenderInfo, Rendered, render};
 pub use verdict::{Judging, ReferenceSphere, Row, Sweep, VerifyReport};
 
-use crate::error::{Error, Field, Hint};
 use crate::blender::{Blender, BlenderOptions};
+use crate::error::{Error, Field, Hint};
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Engine, Roughness, coat};
@@ -120,13 +120,7 @@ pub fn verify_with(
         v.color_model,
     )?;
     let rendered = render(
-        blender,
-        &plan,
-        &groups,
-        v.mode,
-        v.color,
-        &v.blender,
-        progress,
+        blender, &plan, &groups, v.mode, v.color, &v.blender, progress,
     )?;
     let sweep = Sweep {
         coefficients: &coefficients,

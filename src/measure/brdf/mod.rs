@@ -89,8 +89,8 @@ pub trait Brdf {
 /// The grid size [`model_albedo`] uses: `ALBEDO_GRID²` draws per estimate.
 pub const ALBEDO_GRID: usize = 512;
 
-/// The models the CLI can name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// The models the CLI can name (serialised by their Rust names: `CookTorrance`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum Model {
     Lambert,
     Phong,
@@ -203,11 +203,7 @@ impl Default for ModelParams {
 /// ```
 pub fn model_albedo(model: Model, params: &ModelParams, mu: f64) -> Result<f64, Error> {
     if !(mu > 0.0 && mu <= 1.0) {
-        return Err(Error::input(
-            Field::ViewCosine,
-            mu,
-            "a number in (0, 1]",
-        ));
+        return Err(Error::input(Field::ViewCosine, mu, "a number in (0, 1]"));
     }
     Ok(model.brdf(params)?.albedo(mu, ALBEDO_GRID))
 }
