@@ -183,7 +183,7 @@ impl Field {
     pub fn name(self) -> String {
         match self {
             Field::Arguments => "arguments",
-            Field::Blender => "Blender",
+            Field::Blender => "blender",
             Field::BlenderVersion => "Blender version",
             Field::Blend => "library .blend",
             Field::Coefficients => "coefficients",
@@ -204,7 +204,7 @@ impl Field {
             Field::Model => "model",
             Field::ModelParameter(name) => name,
             Field::Out => "output",
-            Field::NoProvision => "the setting that forbids installing bpy",
+            Field::NoProvision => "no-provision",
             Field::Point => "point",
             Field::PointRoughness => "point roughness",
             Field::PointPercent => "point percent",

@@ -508,15 +508,16 @@ fn nothing_found_without_provisioning_says_where_and_how() {
     };
     let err = find_blender_in(&FindOptions::default(), &env, &Quiet).unwrap_err();
     assert!(matches!(err, Error::BlenderNotFound(_)), "{err:?}");
-    let shown = err.to_string();
+    // Fields shown as <Field>: the CLI names them by their flags.
+    let shown = err.render(|f| format!("<{f:?}>"));
     for needle in [
         "no Blender found",
         "GLOFFUSE_BLENDER: not set",
         "`blender` on PATH: not found",
         "home/.cache/gloffuse/bpy-4.5: not provisioned",
-        "--blender PATH",
+        "<Blender> PATH",
         "apt-get install blender",
-        "--no-provision",
+        "drop <NoProvision>",
     ] {
         assert!(shown.contains(needle), "missing {needle:?} in:\n{shown}");
     }
