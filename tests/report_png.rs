@@ -398,7 +398,7 @@ fn full_sweep_sheet_and_plot() {
         } as f32;
         [v * 0.98, v, v * 1.02]
     };
-    let img = grid(roughness.len(), plan.rows(), cell, colour);
+    let img = grid(roughness.len(), plan.image_rows(), cell, colour);
     let dir = tempfile::tempdir().unwrap();
     let sheet_path = dir.path().join("sheet.png");
     contact_sheet(&img, cell, &row_labels, &column_labels, &sheet_path).unwrap();
