@@ -99,7 +99,10 @@ mod tests {
         for n in &notes {
             let s = sentence(n);
             assert!(!s.contains("--"), "{s}");
-            assert!(s.contains(&format!("'{}'", n.suggested_preset().unwrap())), "{s}");
+            assert!(
+                s.contains(&format!("'{}'", n.suggested_preset().unwrap())),
+                "{s}"
+            );
         }
         assert_eq!(
             sentence(&notes[1]),
@@ -122,7 +125,10 @@ mod tests {
             under: None,
             over: Some(worst),
         });
-        assert!(s.starts_with("The coefficients 'seed' are display-referred"), "{s}");
+        assert!(
+            s.starts_with("The coefficients 'seed' are display-referred"),
+            "{s}"
+        );
         assert!(
             s.ends_with(" Over-corrected: 1 sphere, worst GGX r = 0.4 at 104.7 % (gain 1.114; 1/E_avg = 1.063 is needed)."),
             "{s}"

@@ -41,7 +41,14 @@ pub fn judge(
             let rings: Vec<_> = corrected.rings.iter().map(|r| r.mu).collect();
             let curve = &sweep.coefficients.distributions[&slot.distribution].curve;
             let p = predictor.predict(curve, slot.distribution, slot.roughness, slot.ior, &rings);
-            judge_row(slot, stats(slot.uncorrected), corrected, p, judging, sweep.mode)
+            judge_row(
+                slot,
+                stats(slot.uncorrected),
+                corrected,
+                p,
+                judging,
+                sweep.mode,
+            )
         })
         .collect();
     let reference = plan
@@ -125,4 +132,98 @@ fn worst_ring(s: &SphereStats, targets: &[[f64; 3]]) -> f64 {
         .filter(|(r, _)| r.pixels >= MIN_RING_PIXELS)
         .map(|(r, &t)| relative(r.mean_rgb, t).1)
         .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::{Distribution, Roughness};
+    use crate::verify::stats::{RINGS, Ring};
+
+    /// A sphere of mean `mean` (every channel) whose rings have `ring_pixels` pixels each
+    /// and means `ring_mean`.
+    fn sphere(mean: f64, ring_mean: f64, ring_pixels: usize) -> SphereStats {
+        SphereStats {
+            mean,
+            mean_rgb: [mean; 3],
+            standard_error: 0.001,
+            center: mean,
+            coverage: 0.6,
+            rings: (0..RINGS)
+                .map(|k| Ring {
+                    mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64),
+                    pixels: ring_pixels,
+                    mean: ring_mean,
+                    mean_rgb: [ring_mean; 3],
+                })
+                .collect(),
+        }
+    }
+
+    fn prediction() -> Prediction {
+        Prediction {
+            e_avg: 0.5,
+            target: [1.0; 3],
+            ring_targets: vec![[1.0; 3]; RINGS],
+            uncorrected_base: [1.0; 3],
+            uncorrected: 0.5,
+            corrected: 1.0,
+            cycles_uncorrected: None,
+        }
+    }
+
+    fn slot() -> PlanRow {
+        PlanRow {
+            id: 7,
+            distribution: Distribution::Ggx,
+            roughness: Roughness::new(0.5).unwrap(),
+            ior: None,
+            uncorrected: 3,
+            corrected: 4,
+        }
+    }
+
+    /// Thresholds of 50 % and 25 %: exact in binary, so the boundary is exact.
+    const JUDGING: Judging = Judging {
+        tolerance_percent: 50.0,
+        ring_tolerance_percent: 25.0,
+    };
+
+    fn row(mean: f64, ring_mean: f64, ring_pixels: usize, mode: Mode) -> Row {
+        let (u, c) = (sphere(0.5, 0.5, 500), sphere(mean, ring_mean, ring_pixels));
+        judge_row(&slot(), u, c, prediction(), JUDGING, mode)
+    }
+
+    #[test]
+    fn a_mean_on_the_tolerance_passes_and_beyond_fails() {
+        let on = row(1.5, 1.0, 500, Mode::Roughness);
+        assert_eq!((on.deviation, on.brightness), (0.5, 1.5));
+        assert!(on.pass);
+        assert!(row(0.5, 1.0, 500, Mode::Roughness).pass);
+        assert!(!row(1.5000001, 1.0, 500, Mode::Roughness).pass);
+        assert!(!row(0.4999999, 1.0, 500, Mode::Roughness).pass);
+    }
+
+    #[test]
+    fn rings_are_judged_in_the_per_pixel_modes_only() {
+        // Rings 30 % off: the roughness mode shows but does not judge them.
+        let roughness = row(1.0, 1.3, 500, Mode::Roughness);
+        assert!((roughness.worst_ring - 0.3).abs() < 1e-12);
+        assert!(roughness.pass);
+        assert!(!row(1.0, 1.3, 500, Mode::View).pass);
+        assert!(row(1.0, 1.25, 500, Mode::View).pass);
+        // Too few pixels to judge a ring by.
+        let sparse = row(1.0, 1.3, MIN_RING_PIXELS - 1, Mode::View);
+        assert_eq!(sparse.worst_ring, 0.0);
+        assert!(sparse.pass);
+    }
+
+    #[test]
+    fn a_row_carries_its_plan_row() {
+        let r = row(1.0, 1.0, 500, Mode::Roughness);
+        assert_eq!(r.id, 7);
+        assert_eq!(r.roughness, Roughness::new(0.5).unwrap());
+        assert_eq!(r.uncorrected_brightness, 0.5);
+        assert_eq!(r.predicted_uncorrected, 0.5);
+    }
 }

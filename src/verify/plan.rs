@@ -356,3 +356,79 @@ pub struct FurnaceParams {
     pub generate: GenerateParams,
     pub furnace: FurnaceSection,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rs(values: &[f64]) -> Vec<Roughness> {
+        values.iter().map(|&r| Roughness::new(r).unwrap()).collect()
+    }
+
+    /// Every row's id is its place, and its cells hold its distribution, roughness and
+    /// index in the right roles; every reference cell holds a reference sphere.
+    #[test]
+    fn rows_name_their_cells() {
+        let roughness = rs(&[0.0, 0.5, 1.0]);
+        let ds = [Distribution::Ggx, Distribution::Beckmann];
+        let plan = Plan::verify(&ds, &roughness, &[1.33, 1.5], RenderSettings::default());
+        assert_eq!(plan.rows.len(), 2 * ds.len() * roughness.len());
+        assert_eq!(plan.references.len(), 2 * roughness.len());
+        for (i, row) in plan.rows.iter().enumerate() {
+            assert_eq!(row.id, i);
+            let expect = |role| Cell {
+                role,
+                roughness: row.roughness,
+                ior: row.ior,
+            };
+            assert_eq!(
+                plan.cells[row.uncorrected],
+                expect(Role::Uncorrected(row.distribution))
+            );
+            assert_eq!(
+                plan.cells[row.corrected],
+                expect(Role::Corrected(row.distribution))
+            );
+        }
+        // The verdict's order: per index, per distribution, per roughness.
+        let order: Vec<_> = plan
+            .rows
+            .iter()
+            .map(|r| (r.ior, r.distribution, r.roughness.get()))
+            .collect();
+        assert_eq!(order[0], (Some(1.33), Distribution::Ggx, 0.0));
+        assert_eq!(order[4], (Some(1.33), Distribution::Beckmann, 0.5));
+        assert_eq!(order[6], (Some(1.5), Distribution::Ggx, 0.0));
+        for r in &plan.references {
+            let c = &plan.cells[r.cell];
+            assert_eq!(
+                (c.role, c.roughness, c.ior),
+                (Role::Reference, r.roughness, r.ior)
+            );
+        }
+        // Each cell belongs to one row or reference at most.
+        let mut used: Vec<usize> = plan
+            .rows
+            .iter()
+            .flat_map(|r| [r.uncorrected, r.corrected])
+            .chain(plan.references.iter().map(|r| r.cell))
+            .collect();
+        used.sort();
+        used.dedup();
+        assert_eq!(used.len(), plan.cells.len());
+    }
+
+    #[test]
+    fn eevee_lighting_cell_is_no_row() {
+        let settings = RenderSettings::for_engine(Engine::Eevee);
+        let plan = Plan::verify(&[Distribution::Ggx], &rs(&[0.5]), &[], settings);
+        let lighting = plan.lighting().unwrap();
+        assert_eq!(lighting, plan.cells.len() - 1);
+        assert!(plan.rows.iter().all(|r| r.corrected != lighting));
+        assert!(
+            Plan::measure(&[Distribution::Ggx], &rs(&[0.5]), settings)
+                .rows
+                .is_empty()
+        );
+    }
+}
