@@ -37,18 +37,9 @@ pub fn judge(
         .rows
         .iter()
         .map(|slot| {
-            let corrected = stats(slot.corrected);
-            let rings: Vec<_> = corrected.rings.iter().map(|r| r.mu).collect();
-            let curve = &sweep.coefficients.distributions[&slot.distribution].curve;
-            let p = predictor.predict(curve, slot.distribution, slot.roughness, slot.ior, &rings);
-            judge_row(
-                slot,
-                stats(slot.uncorrected),
-                corrected,
-                p,
-                judging,
-                sweep.mode,
-            )
+            let (uncorrected, corrected) = (stats(slot.uncorrected), stats(slot.corrected));
+            let p = predict(&predictor, sweep, slot, &corrected);
+            judge_row(slot, uncorrected, corrected, p, judging, sweep.mode)
         })
         .collect();
     let reference = plan
@@ -75,6 +66,18 @@ pub fn judge(
         rows,
         reference,
     }
+}
+
+/// The prediction for a plan row, ring by ring over the rendered `corrected` sphere's rings.
+fn predict(
+    predictor: &Predictor,
+    sweep: &Sweep,
+    slot: &PlanRow,
+    corrected: &SphereStats,
+) -> Prediction {
+    let rings: Vec<_> = corrected.rings.iter().map(|r| r.mu).collect();
+    let curve = &sweep.coefficients.distributions[&slot.distribution].curve;
+    predictor.predict(curve, slot.distribution, slot.roughness, slot.ior, &rings)
 }
 
 /// One row's verdict: the corrected sphere's mean against its target within the
