@@ -47,8 +47,7 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
         &[Mode::Roughness],
         ColorModel::Exact,
     )?;
-    let rs: Vec<f64> = b.roughness.iter().map(|r| r.get()).collect();
-    let plan = Plan::verify(&Distribution::ALL, &rs, &[], b.render);
+    let plan = Plan::verify(&Distribution::ALL, &b.roughness, &[], b.render);
     let start = Instant::now();
     render(
         &blender,
@@ -67,11 +66,7 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
     progress.begin("one process per sphere", plan.cells.len() as u64);
     let start = Instant::now();
     for cell in &plan.cells {
-        let single = Plan {
-            cells: vec![cell.clone()],
-            columns: 1,
-            settings: b.render,
-        };
+        let single = Plan::of(vec![cell.clone()], 1, b.render);
         let rendered = render(
             &blender,
             &single,

@@ -67,7 +67,7 @@ pub const DISAGREEMENT: f64 = 0.005;
 #[derive(Debug, Serialize)]
 pub struct Measurement {
     pub distribution: Distribution,
-    pub roughness: f64,
+    pub roughness: Roughness,
     /// The sphere's mean, relative to the white Diffuse sphere in EEVEE.
     pub measured: f64,
     pub standard_error: f64,
@@ -89,8 +89,10 @@ pub struct Refreshed {
 }
 
 /// The measurement grid: r = 0.05 … 1 (r = 0 is pinned by the curve's f(0) = 100).
-fn grid() -> Vec<f64> {
-    (1..=20).map(|i| i as f64 / 20.0).collect()
+fn grid() -> Vec<Roughness> {
+    (1..=20)
+        .map(|i| Roughness::new(i as f64 / 20.0).expect("in [0, 1]"))
+        .collect()
 }
 
 /// Measures, fits, writes `a.out` and (unless `a.verify` is off) verifies it.
@@ -130,8 +132,7 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
         let Role::Uncorrected(d) = cell.role else {
             continue;
         };
-        let predicted =
-            integrator.average_albedo(&engine.glossy(d, masking, Roughness::new(cell.roughness)?));
+        let predicted = integrator.average_albedo(&engine.glossy(d, masking, cell.roughness));
         let measured = s.mean * scale;
         if (measured / predicted - 1.0).abs() > DISAGREEMENT {
             warnings.push(format!(
@@ -181,7 +182,7 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
             .iter()
             .filter(|m| m.distribution == d)
             .map(|m| Point {
-                roughness: m.roughness,
+                roughness: m.roughness.get(),
                 percent: 100.0 * m.measured,
             })
             .collect();

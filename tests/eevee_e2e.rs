@@ -160,6 +160,15 @@ fn cycles_groups_in_eevee_render_what_their_descriptions_say() {
         // Beckmann and Ashikhmin-Shirley miss by far: the check fails, as it must.
         assert_eq!(code, 1, "Blender {label}: {v:#}");
         assert_eq!(v["groups_engine"], "cycles");
+        // The notes: EEVEE's lighting, then the Cycles groups with EEVEE's own preset named.
+        let notes = v["notes"].as_array().unwrap();
+        assert_eq!(notes.len(), 2, "Blender {label}: {notes:?}");
+        assert_eq!(notes[0]["kind"], "lighting");
+        assert_eq!(notes[0]["brightness"], v["lighting"]);
+        assert_eq!(notes[1]["kind"], "foreign-groups");
+        assert_eq!(notes[1]["groups_engine"], "cycles");
+        assert_eq!(notes[1]["engine"], "eevee");
+        assert_eq!(notes[1]["suggested"], "eevee");
         for d in Distribution::ALL {
             let quoted = in_eevee(d, Masking::HeightCorrelated);
             for (r, q) in rows_of(&v, d.key()).iter().zip(quoted) {

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use gloffuse::measure::Distribution;
+use gloffuse::measure::{Distribution, Roughness};
 use gloffuse::report::png::{PLOT_SIZE, brightness_plot, contact_sheet, sheet_labels};
 use gloffuse::verify::image::Rgba;
 use gloffuse::verify::plan::{Plan, RenderSettings};
@@ -100,6 +100,7 @@ fn render_info(cell: usize, columns: usize, rows: usize) -> RenderInfo {
 
 /// A row of white spheres: brightness is the rendered mean (the target is white).
 fn white_row(
+    id: usize,
     distribution: Distribution,
     roughness: f64,
     uncorrected: SphereStats,
@@ -108,11 +109,11 @@ fn white_row(
     pass: bool,
 ) -> Row {
     Row {
+        id,
         distribution,
-        roughness,
+        roughness: Roughness::new(roughness).unwrap(),
         ior: None,
         cycles_uncorrected: None,
-        cells: [0, 0],
         target: [1.0; 3],
         uncorrected_brightness: uncorrected.mean,
         brightness: corrected.mean,
@@ -129,7 +130,7 @@ fn white_row(
 
 fn reference_sphere(roughness: f64, stats: SphereStats) -> ReferenceSphere {
     ReferenceSphere {
-        roughness,
+        roughness: Roughness::new(roughness).unwrap(),
         ior: None,
         cell: 0,
         brightness: stats.mean,
@@ -161,6 +162,7 @@ fn small_report(img: &Rgba) -> VerifyReport {
                 0.9 - 0.2 * c as f64
             };
             white_row(
+                c,
                 Distribution::Ggx,
                 roughness[c],
                 stats(c),
@@ -379,7 +381,11 @@ fn full_sweep_sheet_and_plot() {
     let roughness: Vec<f64> = (0..=10).map(|i| i as f64 / 10.0).collect();
     let settings = RenderSettings::default();
     let cell = settings.cell as usize;
-    let plan = Plan::verify(&Distribution::ALL, &roughness, &[], settings);
+    let typed: Vec<Roughness> = roughness
+        .iter()
+        .map(|&r| Roughness::new(r).unwrap())
+        .collect();
+    let plan = Plan::verify(&Distribution::ALL, &typed, &[], settings);
     let (row_labels, column_labels) = sheet_labels(&plan, gloffuse::generate::Mode::Roughness);
     assert_eq!(row_labels.len(), 7);
     assert_eq!(row_labels[4], "Ashikhmin-Shirley uncorrected");
@@ -398,7 +404,7 @@ fn full_sweep_sheet_and_plot() {
         } as f32;
         [v * 0.98, v, v * 1.02]
     };
-    let img = grid(roughness.len(), plan.rows(), cell, colour);
+    let img = grid(roughness.len(), plan.image_rows(), cell, colour);
     let dir = tempfile::tempdir().unwrap();
     let sheet_path = dir.path().join("sheet.png");
     contact_sheet(&img, cell, &row_labels, &column_labels, &sheet_path).unwrap();
@@ -420,6 +426,7 @@ fn full_sweep_sheet_and_plot() {
         })
         .map(|(k, d, c, r)| {
             white_row(
+                k * columns + c,
                 d,
                 r,
                 stats(2 * k * columns + c),

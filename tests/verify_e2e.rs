@@ -39,7 +39,16 @@ fn default_coefficients_pass_in_every_blender() {
         );
         let rows = v["rows"].as_array().unwrap();
         assert_eq!(rows.len(), 33, "3 distributions × 11 roughness values");
-        for r in rows {
+        // The preset of this Blender: nothing to note.
+        assert_eq!(v["notes"], serde_json::json!([]), "Blender {label}");
+        for (i, r) in rows.iter().enumerate() {
+            // Rows are numbered in order; roughness is a plain number.
+            assert_eq!(r["id"].as_u64(), Some(i as u64), "Blender {label}");
+            assert!(
+                r["roughness"].is_f64(),
+                "Blender {label}: {}",
+                r["roughness"]
+            );
             let what = format!("Blender {label} {} r={}", r["distribution"], r["roughness"]);
             let corrected = r["corrected"]["mean"].as_f64().unwrap();
             assert!(
@@ -124,6 +133,21 @@ fn seed_coefficients_fail_and_say_why() {
     let ggx = v["rows"][0]["corrected"]["mean"].as_f64().unwrap();
     // The seed's gain at r = 1 is 100/59 = 1.69; E_avg(1) = 0.409, so about 69 %.
     assert!((ggx - 0.409 * 100.0 / 59.0).abs() < 0.01, "{ggx}");
+    // The note as data: one under-corrected sphere (that row), none over.
+    let notes = v["notes"].as_array().unwrap();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    let note = &notes[0];
+    assert_eq!(note["kind"], "display-referred");
+    assert_eq!(note["coefficients"], "seed");
+    assert!(note.get("over").is_none(), "{note}");
+    let under = &note["under"];
+    assert_eq!(under["count"], 1);
+    assert_eq!(under["distribution"], "ggx");
+    assert_eq!(under["roughness"], 1.0);
+    assert_eq!(under["brightness"], v["rows"][0]["brightness"]);
+    let needed = 1.0 / v["rows"][0]["predicted_uncorrected"].as_f64().unwrap();
+    assert!((under["needed_gain"].as_f64().unwrap() - needed).abs() < 1e-12);
+    assert!((under["gain"].as_f64().unwrap() - 100.0 / 59.0).abs() < 1e-9);
 }
 
 #[test]
@@ -363,4 +387,47 @@ fn label(distribution: &Value) -> &'static str {
         "ggx" => "GGX",
         _ => "Ashikhmin-Shirley",
     }
+}
+
+/// Coefficients of the other masking family: the note names the preset that suits this
+/// Blender (never a flag), and the command line adds the flag that checks with it.
+#[test]
+fn masking_mismatch_names_the_preset_and_the_cli_the_flag() {
+    let Some((label, blender)) = common::blender::real_blenders()
+        .into_iter()
+        .find(|(l, _)| *l == "3.4")
+    else {
+        return;
+    };
+    let args = ["--coefficients", "blender-4", "-r", "1", "-d", "ggx"];
+    let (_, v, stderr) = verify_json(&blender, &[&args[..], &["--json"]].concat());
+    let notes = v["notes"].as_array().unwrap_or_else(|| panic!("{stderr}"));
+    assert_eq!(notes.len(), 1, "Blender {label}: {notes:?}");
+    let n = &notes[0];
+    assert_eq!(n["kind"], "masking-mismatch");
+    assert_eq!(n["distribution"], "ggx");
+    assert_eq!(n["fitted"], "height-correlated");
+    assert_eq!(n["masking"], "separable");
+    assert_eq!(n["blender"], "3.4");
+    assert_eq!(n["suggested"], "blender-3");
+    let out = common::gloffuse()
+        .args(["verify", "--no-provision", "--blender"])
+        .arg(&blender)
+        .args(args)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    let note = text
+        .lines()
+        .find(|l| l.starts_with("note: "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        note.contains("'blender-3'") && !note.contains("--"),
+        "{note}"
+    );
+    assert!(
+        text.lines()
+            .any(|l| l == "hint: rerun with --coefficients blender-3"),
+        "{text}"
+    );
 }

@@ -175,7 +175,7 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
                 eprintln_quietly(&format!("wrote {}", path.display()));
             }
             let out = summary(out, &mut stderr, &[v.junit.as_deref()]);
-            emit(out, v.json, report, gloffuse::report::table::render)?;
+            emit(out, v.json, report, text::verify)?;
             Ok(verdict(report.pass))
         }
         Command::Refresh(a) => {

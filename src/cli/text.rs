@@ -9,6 +9,7 @@ use gloffuse::fit::{ColorSpace, Curve, Shown, Target, Variable, Weighting};
 use gloffuse::generate::Generated;
 use gloffuse::lut::LutSummary;
 use gloffuse::refresh::Refreshed;
+use gloffuse::verify::VerifyReport;
 
 /// The summary `generate` prints.
 pub fn generated(out: &Generated) -> String {
@@ -35,6 +36,22 @@ pub fn generated(out: &Generated) -> String {
     }
     let _ = writeln!(s, "coefficients: {}", out.coefficients);
     let _ = writeln!(s, "groups: {}", out.groups.join(", "));
+    s
+}
+
+/// The verify table, then the flag for each preset a note suggests (the library's notes
+/// name presets; only the command line knows its flags).
+pub fn verify(report: &VerifyReport) -> String {
+    let mut s = gloffuse::report::table::render(report);
+    let mut presets: Vec<&str> = report
+        .notes
+        .iter()
+        .filter_map(|n| n.suggested_preset())
+        .collect();
+    presets.dedup();
+    for p in presets {
+        let _ = writeln!(s, "hint: rerun with --coefficients {p}");
+    }
     s
 }
 
@@ -66,7 +83,7 @@ pub fn refresh(r: &Refreshed) -> String {
     }
     let _ = writeln!(s, "wrote {}", r.out);
     if let Some(v) = &r.verify {
-        let _ = write!(s, "\n{}", gloffuse::report::table::render(v));
+        let _ = write!(s, "\n{}", verify(v));
     }
     s
 }

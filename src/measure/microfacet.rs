@@ -112,7 +112,9 @@ impl std::fmt::Display for Masking {
 }
 
 /// A Glossy node `Roughness` value, guaranteed finite and in [0, 1] (parse, don't validate).
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+/// It serialises as the plain number.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, serde::Serialize)]
+#[serde(transparent)]
 pub struct Roughness(f64);
 
 impl Roughness {

@@ -93,7 +93,11 @@ pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(
     register_font().map_err(|m| write_error(out, m))?;
     let plan = &rendered.plan;
     let cell = plan.settings.cell as usize;
-    let rows: Vec<_> = report.rows.iter().map(|row| (row, row.cells[1])).collect();
+    let rows: Vec<_> = report
+        .rows
+        .iter()
+        .map(|row| (row, plan.rows[row.id].corrected))
+        .collect();
     let series: Vec<String> = {
         let mut s: Vec<_> = rows.iter().map(|(r, _)| r.series()).collect();
         s.dedup();

@@ -89,7 +89,7 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
     if !report.notes.is_empty() {
         s.push_str("<h2>Notes</h2><ul>");
         for n in &report.notes {
-            let _ = write!(s, "<li>{}</li>", escape(n));
+            let _ = write!(s, "<li>{}</li>", escape(&super::notes::sentence(n)));
         }
         s.push_str("</ul>\n");
     }
@@ -115,8 +115,9 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
     let mut rows: Vec<_> = report.rows.iter().collect();
     rows.sort_by_key(|r| r.pass);
     for row in rows {
+        let cells = &plan.rows[row.id];
         let false_colour = png_tag(
-            &deviation::cell_image(rendered, row.cells[1], &row.ring_targets),
+            &deviation::cell_image(rendered, cells.corrected, &row.ring_targets),
             cell,
         );
         let (class, status) = if row.pass {
@@ -136,8 +137,8 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
             100.0 * row.predicted_corrected,
             100.0 * row.corrected.standard_error,
             100.0 * row.worst_ring,
-            thumb(row.cells[0]),
-            thumb(row.cells[1]),
+            thumb(cells.uncorrected),
+            thumb(cells.corrected),
         );
     }
     s.push_str("</table>\n");

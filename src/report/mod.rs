@@ -1,12 +1,13 @@
 //! ⑤ Report: renderers of the verify verdict, one file each — `table` (terminal), `json`
 //! (machines), `junit` (CI servers), `html` (a page for people), `png` (the contact sheet
-//! and the brightness plot), `deviation` (the false-colour view) — and the report folder
-//! that holds them with the rendered EXR.
+//! and the brightness plot), `deviation` (the false-colour view), `notes` (the verdict's
+//! notes in words) — and the report folder that holds them with the rendered EXR.
 
 pub mod deviation;
 pub mod html;
 pub mod json;
 pub mod junit;
+pub mod notes;
 pub mod png;
 pub mod table;
 

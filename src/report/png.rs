@@ -75,7 +75,7 @@ pub fn sheet_labels(plan: &Plan, mode: Mode) -> (Vec<String>, Vec<String>) {
         .cells
         .iter()
         .take(columns)
-        .map(|c| format_roughness(c.roughness))
+        .map(|c| format_roughness(c.roughness.get()))
         .collect();
     (rows, cols)
 }
@@ -261,7 +261,7 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
                     .filter(move |r| r.distribution == d && r.ior == plotted_ior)
             };
             let pts = |f: fn(&crate::verify::Row) -> f64| {
-                percent_points(rows().map(|r| (r.roughness, f(r))))
+                percent_points(rows().map(|r| (r.roughness.get(), f(r))))
             };
             (
                 d,
@@ -279,7 +279,7 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             .reference
             .iter()
             .filter(|s| s.ior == plotted_ior)
-            .map(|s| (s.roughness, s.brightness)),
+            .map(|s| (s.roughness.get(), s.brightness)),
     );
 
     let tolerance = if report.tolerance_percent.is_finite() {
@@ -327,7 +327,7 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
         .map(|&d| {
             let rows = report.rows.iter().filter(|r| r.distribution == d);
             let mut points: Points = rows
-                .map(|r| (r.roughness, 100.0 * (r.brightness - 1.0)))
+                .map(|r| (r.roughness.get(), 100.0 * (r.brightness - 1.0)))
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .collect();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -114,7 +114,7 @@ pub fn render(report: &VerifyReport) -> String {
         report.tolerance_percent
     );
     for n in &report.notes {
-        let _ = writeln!(s, "note: {n}");
+        let _ = writeln!(s, "note: {}", super::notes::sentence(n));
     }
     if !report.pass {
         let _ = writeln!(s, "log: {}\nrerun: {}", i.log, i.command);

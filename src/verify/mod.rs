@@ -1,17 +1,22 @@
 //! ④ Verify: render furnace spheres in one Blender process (`plan`, `render`), read the EXR
-//! back (`image`), measure every sphere (`stats`) and judge it against 100 % and the
-//! integrator's prediction (`verdict`). The verdict is data; `crate::report` renders it.
+//! back (`image`), measure every sphere (`stats`) and judge it (`judge`): predict each row
+//! (`predict`), judge it against 100 % and the prediction, and pick the notes (`notes`). The
+//! verdict is data (`verdict`); `crate::report` renders it.
 
 pub mod image;
+pub mod judge;
+pub mod notes;
 pub mod plan;
+pub mod predict;
 pub mod render;
 pub mod stats;
 pub mod verdict;
 
+pub use judge::judge;
 pub use plan::reference_label;
-pub use plan::{Plan, RenderSettings, Role};
+pub use plan::{Plan, PlanReference, PlanRow, RenderSettings, Role};
 pub use render::{RenderInfo, Rendered, render};
-pub use verdict::{Judging, ReferenceSphere, Row, Sweep, VerifyReport};
+pub use verdict::{Judging, Note, ReferenceSphere, Row, Sweep, VerifyReport, WorstSphere};
 
 use crate::blender::{Blender, BlenderOptions};
 use crate::error::{Error, Field, Hint};
@@ -107,8 +112,7 @@ pub fn verify_with(
     let (coefficients, source) =
         Coefficients::load_or_preset(v.coefficients.as_deref(), v.render.engine, blender.version)?;
     let distributions = distributions_of(v, &coefficients, &source)?;
-    let roughness: Vec<f64> = v.roughness.iter().map(|r| r.get()).collect();
-    let plan = Plan::verify(&distributions, &roughness, &v.ior, v.render);
+    let plan = Plan::verify(&distributions, &v.roughness, &v.ior, v.render);
     let curves = Curves::Pinned {
         coefficients: &coefficients,
         name: &source,
@@ -126,13 +130,13 @@ pub fn verify_with(
         coefficients: &coefficients,
         source: &source,
         distributions: &distributions,
-        roughness: &roughness,
+        roughness: &v.roughness,
         ior: &v.ior,
         mode: v.mode,
         color: v.color,
         color_model: v.color_model,
     };
-    let report = verdict::judge(&rendered, &sweep, v.judging, blender.version)?;
+    let report = judge(&rendered, &sweep, v.judging, blender.version);
     Ok(Verification { report, rendered })
 }
 

@@ -9,7 +9,7 @@ use serde::Serialize;
 use std::path::Path;
 
 use crate::generate::{GenerateParams, GroupSpec, Mode};
-use crate::measure::{Distribution, Engine};
+use crate::measure::{Distribution, Engine, Roughness};
 
 /// What a sphere is shaded with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -62,9 +62,30 @@ pub fn ior_slots(ior: &[f64]) -> Vec<Option<f64>> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
     pub role: Role,
-    pub roughness: f64,
+    pub roughness: Roughness,
     /// The coat's index of refraction (layered mode only).
     pub ior: Option<f64>,
+}
+
+/// One row of the verdict: a distribution at one roughness (and, in layered mode, one
+/// index of refraction), and the cells of its uncorrected and corrected spheres. Its `id`
+/// is its place in [`Plan::rows`]; the verdict's row carries it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanRow {
+    pub id: usize,
+    pub distribution: Distribution,
+    pub roughness: Roughness,
+    pub ior: Option<f64>,
+    pub uncorrected: usize,
+    pub corrected: usize,
+}
+
+/// A reference sphere of the sweep (Multiscatter GGX, or Principled BSDF at `ior`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanReference {
+    pub roughness: Roughness,
+    pub ior: Option<f64>,
+    pub cell: usize,
 }
 
 /// Render settings with their reasons.
@@ -114,6 +135,10 @@ pub struct Plan {
     pub cells: Vec<Cell>,
     pub columns: usize,
     pub settings: RenderSettings,
+    /// The rows a verify sweep judges, in the verdict's order (none in other plans).
+    pub rows: Vec<PlanRow>,
+    /// The reference spheres of a verify sweep, per index then roughness.
+    pub references: Vec<PlanReference>,
 }
 
 impl Plan {
@@ -122,30 +147,58 @@ impl Plan {
     /// `ior` (layered mode), or once with no index when `ior` is empty.
     pub fn verify(
         distributions: &[Distribution],
-        roughness: &[f64],
+        roughness: &[Roughness],
         ior: &[f64],
         settings: RenderSettings,
     ) -> Self {
-        let mut cells = Vec::new();
-        for ior in ior_slots(ior) {
+        let columns = roughness.len();
+        // Each index's block of image rows: two per distribution, then the reference.
+        let block = 2 * distributions.len() + 1;
+        let mut plan = Plan::of(Vec::new(), columns, settings);
+        for (b, ior) in ior_slots(ior).into_iter().enumerate() {
             let roles = distributions
                 .iter()
                 .flat_map(|&d| [Role::Uncorrected(d), Role::Corrected(d)])
                 .chain([Role::Reference]);
             for role in roles {
-                cells.extend(roughness.iter().map(|&r| Cell {
+                plan.cells.extend(roughness.iter().map(|&r| Cell {
                     role,
                     roughness: r,
                     ior,
                 }));
             }
+            let cell = |line: usize, column: usize| (b * block + line) * columns + column;
+            for (k, &d) in distributions.iter().enumerate() {
+                for (c, &r) in roughness.iter().enumerate() {
+                    plan.rows.push(PlanRow {
+                        id: plan.rows.len(),
+                        distribution: d,
+                        roughness: r,
+                        ior,
+                        uncorrected: cell(2 * k, c),
+                        corrected: cell(2 * k + 1, c),
+                    });
+                }
+            }
+            plan.references
+                .extend(roughness.iter().enumerate().map(|(c, &r)| PlanReference {
+                    roughness: r,
+                    ior,
+                    cell: cell(block - 1, c),
+                }));
         }
+        plan.with_lighting()
+    }
+
+    /// A plan of `cells` alone, `columns` to a row, with no rows to judge.
+    pub fn of(cells: Vec<Cell>, columns: usize, settings: RenderSettings) -> Self {
         Plan {
             cells,
-            columns: roughness.len(),
+            columns,
             settings,
+            rows: Vec::new(),
+            references: Vec::new(),
         }
-        .with_lighting()
     }
 
     /// EEVEE's plans end with a white Diffuse sphere, which says how bright its lighting is.
@@ -153,7 +206,7 @@ impl Plan {
         if self.settings.engine == Engine::Eevee {
             self.cells.push(Cell {
                 role: Role::Lighting,
-                roughness: 0.0,
+                roughness: Roughness::new(0.0).expect("0 is a roughness"),
                 ior: None,
             });
         }
@@ -168,7 +221,7 @@ impl Plan {
     /// Uncorrected spheres only (what `refresh` measures).
     pub fn measure(
         distributions: &[Distribution],
-        roughness: &[f64],
+        roughness: &[Roughness],
         settings: RenderSettings,
     ) -> Self {
         let cells = distributions
@@ -181,23 +234,12 @@ impl Plan {
                 })
             })
             .collect();
-        Plan {
-            cells,
-            columns: roughness.len(),
-            settings,
-        }
-        .with_lighting()
+        Plan::of(cells, roughness.len(), settings).with_lighting()
     }
 
-    pub fn rows(&self) -> usize {
+    /// How many lines of cells the image has.
+    pub fn image_rows(&self) -> usize {
         self.cells.len().div_ceil(self.columns)
-    }
-
-    /// The index of the cell of `role` at roughness `r` and index `ior`.
-    pub fn find(&self, role: Role, r: f64, ior: Option<f64>) -> Option<usize> {
-        self.cells
-            .iter()
-            .position(|c| c.role == role && c.roughness == r && c.ior == ior)
     }
 
     /// The parameter document for `furnace_main.py` (the groups plus the furnace section).
@@ -272,24 +314,24 @@ impl Plan {
 pub enum SphereSpec {
     Plain {
         distribution: &'static str,
-        roughness: f64,
+        roughness: Roughness,
     },
     Group {
         group: String,
-        roughness: f64,
+        roughness: Roughness,
         #[serde(skip_serializing_if = "Option::is_none")]
         ior: Option<f64>,
     },
     /// Mix Shader(Fac = Fresnel(ior), Diffuse, white Glossy of `distribution`).
     Mix {
         distribution: &'static str,
-        roughness: f64,
+        roughness: Roughness,
         ior: f64,
     },
     /// Principled BSDF at its defaults, a dielectric of index `ior`.
-    Principled { roughness: f64, ior: f64 },
+    Principled { roughness: Roughness, ior: f64 },
     /// A Diffuse BSDF of the sweep's colour (roughness 0: Lambert).
-    Diffuse { roughness: f64 },
+    Diffuse { roughness: Roughness },
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -313,4 +355,80 @@ pub struct FurnaceParams {
     #[serde(flatten)]
     pub generate: GenerateParams,
     pub furnace: FurnaceSection,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rs(values: &[f64]) -> Vec<Roughness> {
+        values.iter().map(|&r| Roughness::new(r).unwrap()).collect()
+    }
+
+    /// Every row's id is its place, and its cells hold its distribution, roughness and
+    /// index in the right roles; every reference cell holds a reference sphere.
+    #[test]
+    fn rows_name_their_cells() {
+        let roughness = rs(&[0.0, 0.5, 1.0]);
+        let ds = [Distribution::Ggx, Distribution::Beckmann];
+        let plan = Plan::verify(&ds, &roughness, &[1.33, 1.5], RenderSettings::default());
+        assert_eq!(plan.rows.len(), 2 * ds.len() * roughness.len());
+        assert_eq!(plan.references.len(), 2 * roughness.len());
+        for (i, row) in plan.rows.iter().enumerate() {
+            assert_eq!(row.id, i);
+            let expect = |role| Cell {
+                role,
+                roughness: row.roughness,
+                ior: row.ior,
+            };
+            assert_eq!(
+                plan.cells[row.uncorrected],
+                expect(Role::Uncorrected(row.distribution))
+            );
+            assert_eq!(
+                plan.cells[row.corrected],
+                expect(Role::Corrected(row.distribution))
+            );
+        }
+        // The verdict's order: per index, per distribution, per roughness.
+        let order: Vec<_> = plan
+            .rows
+            .iter()
+            .map(|r| (r.ior, r.distribution, r.roughness.get()))
+            .collect();
+        assert_eq!(order[0], (Some(1.33), Distribution::Ggx, 0.0));
+        assert_eq!(order[4], (Some(1.33), Distribution::Beckmann, 0.5));
+        assert_eq!(order[6], (Some(1.5), Distribution::Ggx, 0.0));
+        for r in &plan.references {
+            let c = &plan.cells[r.cell];
+            assert_eq!(
+                (c.role, c.roughness, c.ior),
+                (Role::Reference, r.roughness, r.ior)
+            );
+        }
+        // Each cell belongs to one row or reference at most.
+        let mut used: Vec<usize> = plan
+            .rows
+            .iter()
+            .flat_map(|r| [r.uncorrected, r.corrected])
+            .chain(plan.references.iter().map(|r| r.cell))
+            .collect();
+        used.sort();
+        used.dedup();
+        assert_eq!(used.len(), plan.cells.len());
+    }
+
+    #[test]
+    fn eevee_lighting_cell_is_no_row() {
+        let settings = RenderSettings::for_engine(Engine::Eevee);
+        let plan = Plan::verify(&[Distribution::Ggx], &rs(&[0.5]), &[], settings);
+        let lighting = plan.lighting().unwrap();
+        assert_eq!(lighting, plan.cells.len() - 1);
+        assert!(plan.rows.iter().all(|r| r.corrected != lighting));
+        assert!(
+            Plan::measure(&[Distribution::Ggx], &rs(&[0.5]), settings)
+                .rows
+                .is_empty()
+        );
+    }
 }

@@ -97,7 +97,7 @@ pub fn render(
         command: Some(command.clone()),
     })?;
     let cell = plan.settings.cell as usize;
-    let want = (plan.columns * cell, plan.rows() * cell);
+    let want = (plan.columns * cell, plan.image_rows() * cell);
     if (image.width, image.height) != want {
         return Err(Error::Blender {
             message: format!(

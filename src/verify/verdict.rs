@@ -1,16 +1,14 @@
 //! The verdict of a verify run, as data: what was rendered, what came out, what was
-//! expected, and whether each sphere passes. `crate::report` renders it.
+//! expected, whether each sphere passes, and notes for the reader. `super::judge` makes it;
+//! `crate::report` renders it (and puts the notes into words).
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
-use super::plan::{Role, ior_slots};
-use super::render::{RenderInfo, Rendered};
+use super::render::RenderInfo;
 use super::stats::SphereStats;
-use crate::Error;
-use crate::fit::{Coefficients, ColorSpace, preset_for};
+use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Mode};
-use crate::measure::coat::{Coat, multiscatter_tint};
-use crate::measure::{AlbedoIntegrator, BlenderVersion, Distribution, Engine, Roughness, fresnel};
+use crate::measure::{BlenderVersion, Distribution, Engine, Masking, Roughness};
 
 /// Rings with fewer fully covered pixels than this are too noisy to judge flatness by (at
 /// 64 px per sphere, the outermost ring, μ ∈ [0.3, 0.4), holds 72 pixels: at 32 spp its
@@ -56,14 +54,13 @@ impl Judging {
 /// mode: at one index of refraction, the hand-made Mix Shader and the layered group).
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
+    /// The plan's row this judges ([`super::plan::PlanRow::id`]): it holds the cells.
+    pub id: usize,
     pub distribution: Distribution,
-    pub roughness: f64,
+    pub roughness: Roughness,
     /// The coat's index of refraction (layered mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ior: Option<f64>,
-    /// Where the uncorrected and the corrected sphere are in the plan's cells.
-    #[serde(skip)]
-    pub cells: [usize; 2],
     pub uncorrected: SphereStats,
     pub corrected: SphereStats,
     /// What the colour model promises the corrected sphere's mean is, per channel: the
@@ -116,7 +113,7 @@ impl Row {
 /// Principled BSDF at one index of refraction).
 #[derive(Clone, Debug, Serialize)]
 pub struct ReferenceSphere {
-    pub roughness: f64,
+    pub roughness: Roughness,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ior: Option<f64>,
     /// Where the sphere is in the plan's cells.
@@ -157,20 +154,85 @@ pub struct VerifyReport {
     pub tolerance_percent: f64,
     pub rows: Vec<Row>,
     pub reference: Vec<ReferenceSphere>,
-    /// Explanations for the reader (display-referred coefficients, masking mismatch, …).
-    pub notes: Vec<String>,
+    /// Explanations for the reader (display-referred coefficients, masking mismatch, …), as
+    /// data: `crate::report::notes` puts them into words.
+    pub notes: Vec<Note>,
     pub pass: bool,
 }
 
-/// The largest |ring mean / its target − 1| over the view-cosine rings (with at least
-/// [`MIN_RING_PIXELS`] pixels) and channels of a sphere.
-fn worst_ring(s: &SphereStats, targets: &[[f64; 3]]) -> f64 {
-    s.rings
-        .iter()
-        .zip(targets)
-        .filter(|(r, _)| r.pixels >= MIN_RING_PIXELS)
-        .map(|(r, &t)| relative(r.mean_rgb, t).1)
-        .fold(0.0, f64::max)
+/// Something the reader of a verdict should know, as data (the renderers word it).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Note {
+    /// How bright a white Diffuse sphere renders in `engine` (EEVEE): no sphere can come out
+    /// brighter.
+    Lighting { engine: Engine, brightness: f64 },
+    /// The coefficients correct `groups_engine`'s Glossy, but `engine` rendered the sweep;
+    /// the preset `suggested` holds `engine`'s own groups.
+    ForeignGroups {
+        coefficients: String,
+        groups_engine: Engine,
+        engine: Engine,
+        suggested: &'static str,
+    },
+    /// A distribution's curve was fitted for `fitted` masking, but `blender` uses `masking`;
+    /// the preset `suggested` suits it.
+    MaskingMismatch {
+        distribution: Distribution,
+        fitted: Masking,
+        #[serde(serialize_with = "as_text")]
+        blender: BlenderVersion,
+        masking: Masking,
+        suggested: &'static str,
+    },
+    /// Before 4.0 Principled BSDF's specular F0 stops at 0.08: it cannot reflect like coats
+    /// of these indices, so their reference spheres use Specular 1.
+    PrincipledSpecularCapped {
+        #[serde(serialize_with = "as_text")]
+        blender: BlenderVersion,
+        iors: Vec<f64>,
+    },
+    /// The coefficients are display-referred, so their gain misses; the worst failing sphere
+    /// on each side of 100 %.
+    DisplayReferred {
+        coefficients: String,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        under: Option<WorstSphere>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        over: Option<WorstSphere>,
+    },
+}
+
+impl Note {
+    /// The preset the note suggests instead of the coefficients used, if any.
+    pub fn suggested_preset(&self) -> Option<&'static str> {
+        match self {
+            Note::ForeignGroups { suggested, .. } | Note::MaskingMismatch { suggested, .. } => {
+                Some(suggested)
+            }
+            _ => None,
+        }
+    }
+}
+
+/// The worst failing sphere on one side of 100 %, and how many failed on that side.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WorstSphere {
+    /// Failing spheres on this side.
+    pub count: usize,
+    pub distribution: Distribution,
+    pub roughness: Roughness,
+    /// Its corrected mean relative to the target.
+    pub brightness: f64,
+    /// The coefficients' gain at its roughness.
+    pub gain: f64,
+    /// The gain it needs: 1 / E_avg(r).
+    pub needed_gain: f64,
+}
+
+/// A value as its `Display` text (`"4.5"` for a Blender version).
+fn as_text<T: std::fmt::Display, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(value)
 }
 
 /// What a verify sweep checks: the coefficients (and the name they were loaded by), the
@@ -179,323 +241,11 @@ pub struct Sweep<'a> {
     pub coefficients: &'a Coefficients,
     pub source: &'a str,
     pub distributions: &'a [Distribution],
-    pub roughness: &'a [f64],
+    pub roughness: &'a [Roughness],
     /// Layered mode: the indices of refraction (else empty).
     pub ior: &'a [f64],
     pub mode: Mode,
     /// The spheres' colour and what a correction promises for it.
     pub color: [f64; 3],
     pub color_model: ColorModel,
-}
-
-/// What a correction promises a surface whose (mean) directional albedo is `e`, of a
-/// distribution and roughness with hemispherical albedo `e_avg`: `C` (exact), or
-/// `C (E + Fms (1 − E))` (physical).
-fn target(model: ColorModel, color: [f64; 3], e_avg: f64, e: f64) -> [f64; 3] {
-    match model {
-        ColorModel::Exact => color,
-        ColorModel::Physical => {
-            // Kulla and Conty's tint, as Cycles' Multiscatter GGX applies it per channel.
-            let fms = color.map(|c| multiscatter_tint(c, e_avg));
-            [0, 1, 2].map(|c| color[c] * (e + fms[c] * (1.0 - e)))
-        }
-    }
-}
-
-/// `measured / target` per channel, averaged; and the worst channel's |ratio − 1|.
-fn relative(measured: [f64; 3], target: [f64; 3]) -> (f64, f64) {
-    let ratios = [0, 1, 2].map(|c| measured[c] / target[c]);
-    let worst = ratios.iter().map(|q| (q - 1.0).abs()).fold(0.0, f64::max);
-    (ratios.iter().sum::<f64>() / 3.0, worst)
-}
-
-/// What a layered surface of base colour `C` reflects where its coat reflects `a`:
-/// `a + C (1 − a)` per channel.
-fn layered_target(color: [f64; 3], a: f64) -> [f64; 3] {
-    color.map(|c| a + c * (1.0 - a))
-}
-
-/// What a layered sphere of base colour `C` promises as a whole: `A_avg + C (1 − A_avg)`.
-fn layered_sphere_target(coat: &Coat, color: [f64; 3]) -> [f64; 3] {
-    layered_target(color, coat.average())
-}
-
-/// The mean of an albedo `f(μ)` over a view-cosine ring [lo, hi) of an orthographic sphere,
-/// whose pixels have view-cosine density ∝ μ: `∫ f μ dμ / ∫ μ dμ` by 4-point Gauss–Legendre.
-fn ring_mean(f: impl Fn(f64) -> f64, (lo, hi): (f64, f64)) -> f64 {
-    const NODES: [(f64, f64); 4] = [
-        (0.069_431_844_202_973_7, 0.173_927_422_568_726_9),
-        (0.330_009_478_207_571_9, 0.326_072_577_431_273_1),
-        (0.669_990_521_792_428_1, 0.326_072_577_431_273_1),
-        (0.930_568_155_797_026_3, 0.173_927_422_568_726_9),
-    ];
-    let (mut num, mut den) = (0.0, 0.0);
-    for (x, w) in NODES {
-        let mu = lo + (hi - lo) * x;
-        num += w * mu * f(mu.max(1e-4));
-        den += w * mu;
-    }
-    num / den
-}
-
-/// Judges a rendered verify sweep: every corrected sphere against 100 % (and, in the view
-/// modes, ring by ring), next to the integrator's prediction for `version`'s masking, with
-/// notes where the coefficients do not suit this Blender.
-pub fn judge(
-    rendered: &Rendered,
-    sweep: &Sweep,
-    judging: Judging,
-    version: BlenderVersion,
-) -> Result<VerifyReport, Error> {
-    let Sweep {
-        coefficients,
-        source,
-        distributions,
-        roughness,
-        ior,
-        mode,
-        color,
-        color_model,
-    } = *sweep;
-    let plan = &rendered.plan;
-    let masking = version.masking();
-    // What renders, and what the groups were calibrated for (Cycles groups may be rendered
-    // in EEVEE to show what they do there).
-    let engine = plan.settings.engine;
-    let groups_engine = coefficients.engine();
-    let integrator = AlbedoIntegrator::default();
-    let tolerance = judging.tolerance_percent / 100.0;
-    let find = |role: Role, r: f64, ior: Option<f64>| {
-        plan.find(role, r, ior)
-            .expect("the plan holds every role at every roughness and index")
-    };
-    let iors = ior_slots(ior);
-    let mut rows = Vec::new();
-    for &ior in &iors {
-        for &d in distributions {
-            let curve = &coefficients.distributions[&d].curve;
-            for &r in roughness {
-                let roughness = Roughness::new(r)?;
-                let glossy = engine.glossy(d, masking, roughness);
-                let calibrated = groups_engine.glossy(d, masking, roughness);
-                let coat = ior.map(|n| Coat::new(&integrator, glossy, n));
-                let e_avg = match &coat {
-                    Some(coat) => coat.e_avg(),
-                    None => integrator.average_albedo(&glossy),
-                };
-                let cells = [
-                    find(Role::Uncorrected(d), r, ior),
-                    find(Role::Corrected(d), r, ior),
-                ];
-                let [uncorrected, corrected] = cells.map(|i| rendered.stats[i].clone());
-                // What the sphere promises as a whole and ring by ring (every pixel's target:
-                // shown in every mode, judged in the per-pixel modes).
-                let (target, ring_targets): ([f64; 3], Vec<[f64; 3]>) = match &coat {
-                    Some(coat) => (
-                        layered_sphere_target(coat, color),
-                        corrected
-                            .rings
-                            .iter()
-                            .map(|ring| {
-                                layered_target(color, ring_mean(|mu| coat.albedo(mu), ring.mu))
-                            })
-                            .collect(),
-                    ),
-                    None => (
-                        target(color_model, color, e_avg, e_avg),
-                        corrected
-                            .rings
-                            .iter()
-                            .map(|ring| {
-                                let e = ring_mean(
-                                    |mu| integrator.directional_albedo(&glossy, mu),
-                                    ring.mu,
-                                );
-                                self::target(color_model, color, e_avg, e)
-                            })
-                            .collect(),
-                    ),
-                };
-                let (brightness, deviation) = relative(corrected.mean_rgb, target);
-                let worst_ring = worst_ring(&corrected, &ring_targets);
-                let rings_flat =
-                    !mode.per_pixel() || worst_ring <= judging.ring_tolerance_percent / 100.0;
-                // What the roughness-only gain g gives: C g E_avg (exact), or
-                // C E_avg / (1 − C (1 − 1/g)) (physical).
-                let achieved = |c: f64| match color_model {
-                    ColorModel::Exact => c * curve.gain(r) * e_avg,
-                    ColorModel::Physical => c * e_avg / (1.0 - c * (1.0 - 1.0 / curve.gain(r))),
-                };
-                let predicted_uncorrected = match &coat {
-                    // The hand-made Mix Shader: F E + (1 − F) C, averaged over the sphere.
-                    Some(coat) => relative(coat.hand_mix_average(color), target).0,
-                    None => e_avg,
-                };
-                rows.push(Row {
-                    distribution: d,
-                    roughness: r,
-                    ior,
-                    cells,
-                    cycles_uncorrected: (engine != Engine::Cycles).then(|| {
-                        integrator.average_albedo(&Engine::Cycles.glossy(d, masking, roughness))
-                    }),
-                    uncorrected_brightness: relative(
-                        uncorrected.mean_rgb,
-                        if coat.is_some() { target } else { color },
-                    )
-                    .0,
-                    uncorrected,
-                    pass: deviation <= tolerance && rings_flat,
-                    deviation,
-                    worst_ring,
-                    ring_targets,
-                    brightness,
-                    target,
-                    corrected,
-                    predicted_uncorrected,
-                    predicted_corrected: match mode {
-                        Mode::Roughness => relative(color.map(achieved), target).0,
-                        _ if calibrated == glossy => 1.0,
-                        // Another engine's table: gain E/E' per pixel, or E + (1 − E').
-                        Mode::View => integrator.hemispherical_average(|mu| {
-                            integrator.directional_albedo(&glossy, mu)
-                                / integrator.directional_albedo(&calibrated, mu)
-                        }),
-                        Mode::Multiscatter => 1.0 + e_avg - integrator.average_albedo(&calibrated),
-                        Mode::Layered => 1.0,
-                    },
-                });
-            }
-        }
-    }
-    let mut reference = Vec::new();
-    for &ior in &iors {
-        for &r in roughness {
-            let ggx = engine.glossy(Distribution::Ggx, masking, Roughness::new(r)?);
-            // Multiscatter GGX promises what a corrected GGX sphere does; Principled BSDF
-            // what a layered GGX coat does.
-            let promise = match ior {
-                Some(n) => layered_sphere_target(&Coat::new(&integrator, ggx, n), color),
-                None => {
-                    let e_avg = integrator.average_albedo(&ggx);
-                    target(color_model, color, e_avg, e_avg)
-                }
-            };
-            let cell = find(Role::Reference, r, ior);
-            let stats = rendered.stats[cell].clone();
-            reference.push(ReferenceSphere {
-                roughness: r,
-                ior,
-                cell,
-                brightness: relative(stats.mean_rgb, promise).0,
-                stats,
-            });
-        }
-    }
-    let pass = rows.iter().all(|r| r.pass);
-    let lighting = plan
-        .lighting()
-        .map(|cell| relative(rendered.stats[cell].mean_rgb, color).0);
-    let mut notes = Vec::new();
-    if let Some(l) = lighting {
-        notes.push(format!(
-            "{engine}'s lighting: a white Diffuse sphere renders at {:.2} % in this sweep (EEVEE Next's world probe loses about 0.8 %; EEVEE Legacy none), so no sphere can come out brighter than that.",
-            100.0 * l
-        ));
-    }
-    if groups_engine != engine {
-        notes.push(format!(
-            "The coefficients '{source}' correct {groups_engine}'s Glossy, rendered here in {engine}{}: use --coefficients {} for {engine}'s own groups.",
-            match engine {
-                Engine::Eevee => ", which renders every distribution as its GGX",
-                Engine::Cycles => "",
-            },
-            preset_for(engine, version)
-        ));
-    }
-    for (d, e) in &coefficients.distributions {
-        if e.masking != masking
-            && e.engine == Engine::Cycles
-            && engine == Engine::Cycles
-            && e.color_space == ColorSpace::Linear
-            && distributions.contains(d)
-        {
-            notes.push(format!(
-                "{}: the coefficients were fitted for {} masking, but Blender {} uses {} masking; use --coefficients {}.",
-                d.label(),
-                e.masking,
-                version,
-                masking,
-                preset_for(engine, version)
-            ));
-        }
-    }
-    // Before 4.0 Principled's specular F0 is 0.08 × Specular, and Specular stops at 1.
-    let capped: Vec<String> = ior
-        .iter()
-        .filter(|&&n| version.major < 4 && fresnel::f0(n) > 0.08 + 1e-12)
-        .map(|n| n.to_string())
-        .collect();
-    if !capped.is_empty() {
-        notes.push(format!(
-            "Blender {version}'s Principled BSDF cannot reflect like a coat of IOR {}: its specular F0 is 0.08 × Specular and Specular stops at 1 (F0 0.08, IOR 1.79), so those reference spheres use Specular 1.",
-            capped.join(", ")
-        ));
-    }
-    if coefficients
-        .distributions
-        .values()
-        .any(|e| e.color_space == ColorSpace::Display)
-    {
-        // The worst failing sphere on each side of 100 %: the display-referred curve
-        // over-corrects some roughness values and under-corrects others.
-        let worst = |under: bool| {
-            rows.iter()
-                .filter(|r| !r.pass && (r.brightness < 1.0) == under)
-                .max_by(|a, b| {
-                    (a.brightness - 1.0)
-                        .abs()
-                        .total_cmp(&(b.brightness - 1.0).abs())
-                })
-        };
-        let mut note = format!(
-            "The coefficients '{source}' are display-referred: their percentages are sRGB-encoded brightness read off a screen (sRGB(0.305) ≈ 0.59 is GGX's centre at r = 1), but a shader gain acts on linear light, so 100/f(r) misses."
-        );
-        for (under, verb) in [(true, "Under-corrected"), (false, "Over-corrected")] {
-            if let Some(w) = worst(under) {
-                let count = rows
-                    .iter()
-                    .filter(|r| !r.pass && (r.brightness < 1.0) == under)
-                    .count();
-                note.push_str(&format!(
-                    " {verb}: {count} sphere{}, worst {} r = {} at {:.1} % (gain {:.3}; 1/E_avg = {:.3} is needed).",
-                    if count == 1 { "" } else { "s" },
-                    w.distribution.label(),
-                    w.roughness,
-                    100.0 * w.brightness,
-                    coefficients.distributions[&w.distribution]
-                        .curve
-                        .gain(w.roughness),
-                    1.0 / w.predicted_uncorrected
-                ));
-            }
-        }
-        notes.push(note);
-    }
-    Ok(VerifyReport {
-        coefficients: source.to_string(),
-        engine,
-        groups_engine,
-        lighting,
-        mode,
-        color,
-        color_model,
-        ring_tolerance_percent: judging.ring_tolerance_percent,
-        render: rendered.info.clone(),
-        tolerance_percent: judging.tolerance_percent,
-        rows,
-        reference,
-        notes,
-        pass,
-    })
 }

@@ -1,0 +1,320 @@
+//! Which notes a verdict carries: each a check of the sweep and its outcome that returns a
+//! [`Note`] (data; `crate::report::notes` words it).
+
+use super::verdict::{Note, Row, Sweep, WorstSphere};
+use crate::fit::{ColorSpace, preset_for};
+use crate::measure::{BlenderVersion, Engine, fresnel};
+
+/// The notes for a sweep rendered in `engine` of Blender `version`, with the white Diffuse
+/// sphere's brightness `lighting` (EEVEE) and the judged `rows`, in a fixed order.
+pub fn notes(
+    sweep: &Sweep,
+    engine: Engine,
+    version: BlenderVersion,
+    lighting: Option<f64>,
+    rows: &[Row],
+) -> Vec<Note> {
+    let lighting = lighting.map(|brightness| Note::Lighting { engine, brightness });
+    lighting
+        .into_iter()
+        .chain(foreign_groups(sweep, engine, version))
+        .chain(masking_mismatches(sweep, engine, version))
+        .chain(principled_capped(sweep.ior, version))
+        .chain(display_referred(sweep, rows))
+        .collect()
+}
+
+/// The groups are calibrated for another engine than the one rendering.
+fn foreign_groups(sweep: &Sweep, engine: Engine, version: BlenderVersion) -> Option<Note> {
+    let groups_engine = sweep.coefficients.engine();
+    (groups_engine != engine).then(|| Note::ForeignGroups {
+        coefficients: sweep.source.to_string(),
+        groups_engine,
+        engine,
+        suggested: preset_for(engine, version),
+    })
+}
+
+/// Every checked distribution whose linear Cycles curve was fitted for the other masking
+/// family than `version`'s (judged in Cycles only: EEVEE renders its own GGX).
+fn masking_mismatches(sweep: &Sweep, engine: Engine, version: BlenderVersion) -> Vec<Note> {
+    let masking = version.masking();
+    sweep
+        .coefficients
+        .distributions
+        .iter()
+        .filter(|(d, e)| {
+            e.masking != masking
+                && e.engine == Engine::Cycles
+                && engine == Engine::Cycles
+                && e.color_space == ColorSpace::Linear
+                && sweep.distributions.contains(d)
+        })
+        .map(|(&distribution, e)| Note::MaskingMismatch {
+            distribution,
+            fitted: e.masking,
+            blender: version,
+            masking,
+            suggested: preset_for(engine, version),
+        })
+        .collect()
+}
+
+/// Before 4.0 Principled's specular F0 is 0.08 × Specular, and Specular stops at 1: the
+/// indices whose coat reflects more.
+fn principled_capped(ior: &[f64], version: BlenderVersion) -> Option<Note> {
+    let iors: Vec<f64> = ior
+        .iter()
+        .copied()
+        .filter(|&n| version.major < 4 && fresnel::f0(n) > 0.08 + 1e-12)
+        .collect();
+    (!iors.is_empty()).then_some(Note::PrincipledSpecularCapped {
+        blender: version,
+        iors,
+    })
+}
+
+/// Display-referred coefficients: the worst failing sphere on each side of 100 % (the
+/// display-referred curve over-corrects some roughness values and under-corrects others).
+fn display_referred(sweep: &Sweep, rows: &[Row]) -> Option<Note> {
+    let c = sweep.coefficients;
+    if !c
+        .distributions
+        .values()
+        .any(|e| e.color_space == ColorSpace::Display)
+    {
+        return None;
+    }
+    let worst = |under: bool| {
+        let failing = rows
+            .iter()
+            .filter(|r| !r.pass && (r.brightness < 1.0) == under);
+        let count = failing.clone().count();
+        let w = failing.max_by(|a, b| {
+            (a.brightness - 1.0)
+                .abs()
+                .total_cmp(&(b.brightness - 1.0).abs())
+        })?;
+        Some(WorstSphere {
+            count,
+            distribution: w.distribution,
+            roughness: w.roughness,
+            brightness: w.brightness,
+            gain: c.distributions[&w.distribution]
+                .curve
+                .gain(w.roughness.get()),
+            needed_gain: 1.0 / w.predicted_uncorrected,
+        })
+    };
+    Some(Note::DisplayReferred {
+        coefficients: sweep.source.to_string(),
+        under: worst(true),
+        over: worst(false),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::Coefficients;
+    use crate::generate::{ColorModel, Mode};
+    use crate::measure::{Distribution, Masking, Roughness};
+    use crate::verify::stats::SphereStats;
+
+    fn version(v: &str) -> BlenderVersion {
+        v.parse().unwrap()
+    }
+
+    /// The preset `name`'s coefficients, loaded once per test.
+    fn preset(name: &'static str) -> (Coefficients, &'static str) {
+        (Coefficients::load(name).unwrap(), name)
+    }
+
+    fn sweep<'a>(
+        (c, source): &'a (Coefficients, &'static str),
+        ds: &'a [Distribution],
+        ior: &'a [f64],
+    ) -> Sweep<'a> {
+        Sweep {
+            coefficients: c,
+            source,
+            distributions: ds,
+            roughness: &[],
+            ior,
+            mode: if ior.is_empty() {
+                Mode::Roughness
+            } else {
+                Mode::Layered
+            },
+            color: [1.0; 3],
+            color_model: ColorModel::Exact,
+        }
+    }
+
+    fn row(d: Distribution, r: f64, brightness: f64, pass: bool) -> Row {
+        let stats = SphereStats {
+            mean: brightness,
+            mean_rgb: [brightness; 3],
+            standard_error: 0.0,
+            center: brightness,
+            coverage: 0.6,
+            rings: vec![],
+        };
+        Row {
+            id: 0,
+            distribution: d,
+            roughness: Roughness::new(r).unwrap(),
+            ior: None,
+            uncorrected: stats.clone(),
+            corrected: stats,
+            target: [1.0; 3],
+            uncorrected_brightness: 0.5,
+            brightness,
+            deviation: (brightness - 1.0).abs(),
+            predicted_uncorrected: 0.5,
+            cycles_uncorrected: None,
+            predicted_corrected: 1.0,
+            ring_targets: vec![],
+            worst_ring: 0.0,
+            pass,
+        }
+    }
+
+    #[test]
+    fn the_preset_of_this_blender_needs_no_note() {
+        let c = preset("blender-4");
+        let ds = Distribution::ALL;
+        let n = notes(
+            &sweep(&c, &ds, &[]),
+            Engine::Cycles,
+            version("4.5"),
+            None,
+            &[],
+        );
+        assert_eq!(n, []);
+    }
+
+    #[test]
+    fn another_masking_family_names_the_preset_that_suits() {
+        let c = preset("blender-4");
+        // Only the distributions checked are noted.
+        let ds = [Distribution::Ggx];
+        let n = notes(
+            &sweep(&c, &ds, &[]),
+            Engine::Cycles,
+            version("3.4"),
+            None,
+            &[],
+        );
+        assert_eq!(
+            n,
+            [Note::MaskingMismatch {
+                distribution: Distribution::Ggx,
+                fitted: Masking::HeightCorrelated,
+                blender: version("3.4"),
+                masking: Masking::Separable,
+                suggested: "blender-3",
+            }]
+        );
+    }
+
+    #[test]
+    fn cycles_groups_in_eevee_come_after_the_lighting() {
+        let c = preset("blender-4");
+        let ds = Distribution::ALL;
+        let s = sweep(&c, &ds, &[]);
+        let n = notes(&s, Engine::Eevee, version("4.5"), Some(0.992), &[]);
+        assert_eq!(
+            n,
+            [
+                Note::Lighting {
+                    engine: Engine::Eevee,
+                    brightness: 0.992
+                },
+                Note::ForeignGroups {
+                    coefficients: "blender-4".into(),
+                    groups_engine: Engine::Cycles,
+                    engine: Engine::Eevee,
+                    suggested: "eevee",
+                }
+            ]
+        );
+        assert_eq!(n[1].suggested_preset(), Some("eevee"));
+        assert_eq!(n[0].suggested_preset(), None);
+    }
+
+    #[test]
+    fn principled_is_capped_before_4_0_only() {
+        let c = preset("blender-3");
+        let ds = [Distribution::Ggx];
+        let ior = [1.33, 1.5, 2.0];
+        // F0 of IOR 2 is 1/9 > 0.08; of 1.5 it is 0.04.
+        let n = notes(
+            &sweep(&c, &ds, &ior),
+            Engine::Cycles,
+            version("3.4"),
+            None,
+            &[],
+        );
+        assert_eq!(
+            n,
+            [Note::PrincipledSpecularCapped {
+                blender: version("3.4"),
+                iors: vec![2.0],
+            }]
+        );
+        let c4 = preset("blender-4");
+        let s = sweep(&c4, &ds, &ior);
+        assert_eq!(notes(&s, Engine::Cycles, version("4.5"), None, &[]), []);
+    }
+
+    #[test]
+    fn display_referred_coefficients_name_the_worst_failure_on_each_side() {
+        let c = preset("seed");
+        let ds = [Distribution::Ggx];
+        let rows = [
+            row(Distribution::Ggx, 0.2, 1.02, false),
+            row(Distribution::Ggx, 0.4, 1.047, false),
+            row(Distribution::Ggx, 0.6, 0.999, true),
+            row(Distribution::Ggx, 0.8, 0.9, false),
+            row(Distribution::Ggx, 1.0, 0.694, false),
+            // Passing spheres are not counted, however far off.
+            row(Distribution::Ggx, 0.0, 0.5, true),
+        ];
+        let n = notes(
+            &sweep(&c, &ds, &[]),
+            Engine::Cycles,
+            version("4.5"),
+            None,
+            &rows,
+        );
+        let [Note::DisplayReferred { under, over, .. }] = &n[..] else {
+            panic!("{n:?}");
+        };
+        let (under, over) = (under.as_ref().unwrap(), over.as_ref().unwrap());
+        assert_eq!((under.count, under.roughness.get()), (2, 1.0));
+        assert_eq!((over.count, over.roughness.get()), (2, 0.4));
+        assert_eq!(under.brightness, 0.694);
+        assert_eq!(under.needed_gain, 2.0);
+        assert_eq!(
+            under.gain,
+            c.0.distributions[&Distribution::Ggx].curve.gain(1.0)
+        );
+        // No failure above 100 %: no over-corrected sphere.
+        let n = notes(
+            &sweep(&c, &ds, &[]),
+            Engine::Cycles,
+            version("4.5"),
+            None,
+            &rows[3..],
+        );
+        assert!(matches!(
+            &n[..],
+            [Note::DisplayReferred {
+                over: None,
+                under: Some(_),
+                ..
+            }]
+        ));
+    }
+}
