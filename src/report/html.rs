@@ -72,8 +72,8 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
     let _ = writeln!(
         s,
         "<h2>Thresholds</h2><ul>\
-         <li><b>tolerance</b> (<code>--tolerance</code>): every channel of a corrected sphere's mean within ±{} % of what the correction promises.</li>\
-         <li><b>ring tolerance</b> (<code>--ring-tolerance</code>, every mode but roughness): every view-cosine ring with at least {MIN_RING_PIXELS} fully covered pixels within ±{} %.</li>\
+         <li><b>tolerance</b>: every channel of a corrected sphere's mean within ±{} % of what the correction promises.</li>\
+         <li><b>ring tolerance</b> (every mode but roughness): every view-cosine ring with at least {MIN_RING_PIXELS} fully covered pixels within ±{} %.</li>\
          <li>The false-colour thumbnails saturate at ±{} %.</li></ul>",
         report.tolerance_percent,
         report.ring_tolerance_percent,
