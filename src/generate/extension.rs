@@ -21,7 +21,7 @@ pub const ID: &str = "gloffuse";
 pub const LIBRARY_FOLDER: &str = "library";
 pub const LIBRARY_FILE: &str = "gloffuse.blend";
 
-const ADDON: &str = include_str!("../../blender_scripts/extension/__init__.py");
+const ADDON: &str = include_str!("../../blender/gloffuse_blender/addon.py");
 const LICENSE: &str = include_str!("../../LICENSE");
 
 /// The manifest. `blender_version_min` is the Blender that saved the library: an older one

@@ -10,29 +10,29 @@ use serde::Serialize;
 /// The library parts, in the order they are concatenated: each defines functions only,
 /// and may use what the parts before it define (see `docs/ARCHITECTURE.md`).
 pub const PARTS: [(&str, &str); 9] = [
-    ("compat.py", include_str!("../../blender_scripts/compat.py")),
-    ("params.py", include_str!("../../blender_scripts/params.py")),
-    ("nodes.py", include_str!("../../blender_scripts/nodes.py")),
+    ("compat.py", include_str!("../../blender/gloffuse_blender/compat.py")),
+    ("params.py", include_str!("../../blender/gloffuse_blender/params.py")),
+    ("nodes.py", include_str!("../../blender/gloffuse_blender/nodes.py")),
     (
         "roughness_groups.py",
-        include_str!("../../blender_scripts/roughness_groups.py"),
+        include_str!("../../blender/gloffuse_blender/roughness_groups.py"),
     ),
     (
         "normal_group.py",
-        include_str!("../../blender_scripts/normal_group.py"),
+        include_str!("../../blender/gloffuse_blender/normal_group.py"),
     ),
     (
         "view_groups.py",
-        include_str!("../../blender_scripts/view_groups.py"),
+        include_str!("../../blender/gloffuse_blender/view_groups.py"),
     ),
     (
         "layered_groups.py",
-        include_str!("../../blender_scripts/layered_groups.py"),
+        include_str!("../../blender/gloffuse_blender/layered_groups.py"),
     ),
-    ("groups.py", include_str!("../../blender_scripts/groups.py")),
+    ("groups.py", include_str!("../../blender/gloffuse_blender/groups.py")),
     (
         "runtime.py",
-        include_str!("../../blender_scripts/runtime.py"),
+        include_str!("../../blender/gloffuse_blender/runtime.py"),
     ),
 ];
 
@@ -40,7 +40,7 @@ pub const PARTS: [(&str, &str); 9] = [
 /// scripts that render, after [`PARTS`].
 pub const FURNACE_PART: (&str, &str) = (
     "furnace.py",
-    include_str!("../../blender_scripts/furnace.py"),
+    include_str!("../../blender/gloffuse_blender/furnace.py"),
 );
 
 /// What a script does when it runs: the parts appended after the library, main last.
@@ -59,18 +59,18 @@ impl Job {
             Job::Generate => vec![
                 (
                     "previews.py",
-                    include_str!("../../blender_scripts/previews.py"),
+                    include_str!("../../blender/gloffuse_blender/previews.py"),
                 ),
                 (
                     "generate_main.py",
-                    include_str!("../../blender_scripts/generate_main.py"),
+                    include_str!("../../blender/gloffuse_blender/generate.py"),
                 ),
             ],
             Job::Furnace => vec![
                 FURNACE_PART,
                 (
                     "furnace_main.py",
-                    include_str!("../../blender_scripts/furnace_main.py"),
+                    include_str!("../../blender/gloffuse_blender/furnace_job.py"),
                 ),
             ],
         }
