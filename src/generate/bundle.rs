@@ -115,10 +115,16 @@ impl fmt::Display for BundleError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::UnknownModule { module, imports } => {
-                write!(f, "{module}.py imports {imports}, which {PACKAGE} does not have")
+                write!(
+                    f,
+                    "{module}.py imports {imports}, which {PACKAGE} does not have"
+                )
             }
             Self::UnknownName { module, from, name } => {
-                write!(f, "{module}.py imports {name} from {from}.py, which does not define it")
+                write!(
+                    f,
+                    "{module}.py imports {name} from {from}.py, which does not define it"
+                )
             }
             Self::DuplicateName {
                 name,
@@ -232,7 +238,9 @@ fn parse(module: &str, source: &str) -> Result<Parsed, BundleError> {
             continue;
         }
         if let Some(rest) = line.strip_prefix("from ") {
-            let (from, names) = rest.split_once(" import ").ok_or_else(|| unsupported(line))?;
+            let (from, names) = rest
+                .split_once(" import ")
+                .ok_or_else(|| unsupported(line))?;
             let from = from.trim();
             let mut statement = line.to_string();
             let mut names = names.to_string();
@@ -251,20 +259,22 @@ fn parse(module: &str, source: &str) -> Result<Parsed, BundleError> {
                 .filter(|n| !n.is_empty())
                 .map(str::to_string)
                 .collect();
-            if names.iter().any(|n| !is_identifier(n)) {
-                return Err(unsupported(&statement));
-            }
             if from == "." || from == PACKAGE {
                 return Err(unsupported(&statement));
             }
             match package_module(from) {
-                Some(target) if is_identifier(target) => {
+                Some(target) if is_identifier(target) && names.iter().all(|n| is_identifier(n)) => {
                     parsed.imports.push((target.to_string(), names));
                 }
                 Some(_) => return Err(unsupported(&statement)),
                 None if from.starts_with('.') => return Err(unsupported(&statement)),
                 None => {
-                    parsed.imported.extend(names);
+                    // `from os import path as p` binds p.
+                    let bound = names.iter().map(|n| match n.split_once(" as ") {
+                        Some((_, alias)) => alias.trim().to_string(),
+                        None => n.clone(),
+                    });
+                    parsed.imported.extend(bound);
                     parsed.push_import(&statement);
                 }
             }
@@ -425,7 +435,10 @@ pub fn bundle_with(name: &str, text: &str) -> Result<Vec<Part>, BundleError> {
 pub fn concatenate(parts: &[Part]) -> String {
     let mut s = String::new();
     for part in parts {
-        s.push_str(&format!("\n# ======== gloffuse part: {} ========\n", part.label));
+        s.push_str(&format!(
+            "\n# ======== gloffuse part: {} ========\n",
+            part.label
+        ));
         s.push_str(&part.text);
         if !part.text.ends_with('\n') {
             s.push('\n');
@@ -468,7 +481,10 @@ mod tests {
     #[test]
     fn order_follows_the_imports_depth_first() {
         let modules = [
-            ("a", "from .b import f\nfrom .c import g\n\ndef main(x):\n    f(g(x))\n"),
+            (
+                "a",
+                "from .b import f\nfrom .c import g\n\ndef main(x):\n    f(g(x))\n",
+            ),
             ("b", "from .c import g\n\n\ndef f(x):\n    return g(x)\n"),
             ("c", "import math\n\n\ndef g(x):\n    return math.sqrt(x)\n"),
         ];
@@ -487,10 +503,7 @@ mod tests {
 
     #[test]
     fn multi_line_and_absolute_imports_are_resolved_and_dropped() {
-        let modules = [(
-            "c",
-            "X = 1\n\n\ndef g():\n    \"\"\"Text\nY = 2\n\"\"\"\n",
-        )];
+        let modules = [("c", "X = 1\n\n\ndef g():\n    \"\"\"Text\nY = 2\n\"\"\"\n")];
         let main = "import os\nfrom gloffuse_blender.c import (\n    X,  # one\n    g,\n)\n\n\ndef main(t):\n    g()\n";
         let parts = bundle_from(&modules, Some(("t", main)), "t").unwrap();
         assert_eq!(labels(&parts), ["c.py", "t.py"]);
@@ -504,23 +517,29 @@ mod tests {
             ("b", "def f():\n    pass\n\n\ng = 1\n"),
         ];
         let err = bundle_from(&modules, None, "a").unwrap_err();
-        assert!(matches!(&err, BundleError::DuplicateName { name, .. } if name == "g"), "{err}");
+        assert!(
+            matches!(&err, BundleError::DuplicateName { name, .. } if name == "g"),
+            "{err}"
+        );
         let modules = [
             ("a", "from .b import f\nimport math\n"),
             ("b", "def math():\n    pass\n\n\ndef f():\n    pass\n"),
         ];
         let err = bundle_from(&modules, None, "a").unwrap_err();
-        assert!(matches!(&err, BundleError::DuplicateName { name, .. } if name == "math"), "{err}");
+        assert!(
+            matches!(&err, BundleError::DuplicateName { name, .. } if name == "math"),
+            "{err}"
+        );
     }
 
     #[test]
     fn unknown_modules_names_and_cycles_are_refused() {
-        let modules = [
-            ("a", "from .b import f\n"),
-            ("b", "def g():\n    pass\n"),
-        ];
+        let modules = [("a", "from .b import f\n"), ("b", "def g():\n    pass\n")];
         let err = bundle_from(&modules, None, "a").unwrap_err();
-        assert!(matches!(&err, BundleError::UnknownName { name, .. } if name == "f"), "{err}");
+        assert!(
+            matches!(&err, BundleError::UnknownName { name, .. } if name == "f"),
+            "{err}"
+        );
         let modules = [("a", "from .nothing import f\n")];
         let err = bundle_from(&modules, None, "a").unwrap_err();
         assert!(matches!(err, BundleError::UnknownModule { .. }), "{err}");
@@ -529,7 +548,10 @@ mod tests {
             ("b", "from .a import g\n\n\ndef f():\n    pass\n"),
         ];
         let err = bundle_from(&modules, None, "a").unwrap_err();
-        assert_eq!(err, BundleError::Cycle(vec!["a".into(), "b".into(), "a".into()]));
+        assert_eq!(
+            err,
+            BundleError::Cycle(vec!["a".into(), "b".into(), "a".into()])
+        );
         for import in [
             "from . import b\n",
             "from .b import f as h\n",
@@ -539,7 +561,10 @@ mod tests {
         ] {
             let modules = [("a", import), ("b", "def f():\n    pass\n")];
             let err = bundle_from(&modules, None, "a").unwrap_err();
-            assert!(matches!(err, BundleError::Unsupported { .. }), "{import}: {err}");
+            assert!(
+                matches!(err, BundleError::Unsupported { .. }),
+                "{import}: {err}"
+            );
         }
     }
 
@@ -558,6 +583,9 @@ mod tests {
 
     #[test]
     fn the_addon_ships_as_it_is() {
-        assert_eq!(addon(), MODULES.iter().find(|(n, _)| *n == "addon").unwrap().1);
+        assert_eq!(
+            addon(),
+            MODULES.iter().find(|(n, _)| *n == "addon").unwrap().1
+        );
     }
 }
