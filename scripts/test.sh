@@ -4,6 +4,7 @@
 #   Blender 4.5 LTS and 5.0 — PyPI's `bpy` (Blender as a Python module, CPython 3.11)
 #   Chromium — Debian's `chromium`, to load and screenshot the HTML report
 #   Mesa's software OpenGL (`libegl1`, `libgl1-mesa-dri`) — EEVEE renders headless with it
+#   ruff — PyPI's, to lint the Blender-side Python and the bundled scripts (tests/python_lint.rs)
 # Idempotent: a second run reuses what the first installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,15 +37,28 @@ provision_bpy() { # name, pip requirement
         mv "$dir.partial" "$dir"
     fi
 }
+provision_ruff() { # pip requirement
+    local dir="$cache/ruff"
+    if [ ! -x "$dir/bin/ruff" ] || ! "$dir/bin/ruff" --version >/dev/null 2>&1; then
+        echo "== installing $1 into $dir"
+        rm -rf "$dir.partial" "$dir"
+        "$python" -m venv "$dir.partial"
+        "$dir.partial/bin/pip" install --quiet --progress-bar off "$1"
+        mv "$dir.partial" "$dir"
+    fi
+}
 provision_bpy bpy-4.5 'bpy>=4.5,<4.6' & bpy45=$!
 provision_bpy bpy-5.0 'bpy>=5.0,<5.1' & bpy50=$!
-wait "$bpy45"; wait "$bpy50"
+provision_ruff 'ruff>=0.17,<0.18' & ruff=$!
+wait "$bpy45"; wait "$bpy50"; wait "$ruff"
 
 export GLOFFUSE_TEST_BLENDER_34="$(command -v blender)"
 export GLOFFUSE_TEST_BPY_45="$cache/bpy-4.5/bin/python"
 export GLOFFUSE_TEST_BPY_50="$cache/bpy-5.0/bin/python"
+export GLOFFUSE_TEST_RUFF="$cache/ruff/bin/ruff"
 "$GLOFFUSE_TEST_BLENDER_34" -b --factory-startup -noaudio --version 2>/dev/null | head -1
 "$GLOFFUSE_TEST_BPY_45" -c "import bpy; print('bpy', bpy.app.version_string)"
 "$GLOFFUSE_TEST_BPY_50" -c "import bpy; print('bpy', bpy.app.version_string)"
+"$GLOFFUSE_TEST_RUFF" --version
 
 cargo test --locked "$@"

@@ -29,8 +29,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use gloffuse::blender::{Run, probe, run_script};
-use gloffuse::generate::script::FURNACE_PART;
-use gloffuse::generate::{ColorModel, Curves, GenerateParams, Mode, assemble_parts};
+use gloffuse::generate::{ColorModel, Curves, GenerateParams, Mode, assemble_with_main};
 use gloffuse::measure::shading_normal::ReflectionRule;
 use gloffuse::measure::{
     AlbedoIntegrator, BlenderVersion, Distribution, Engine, Glossy, Masking, Roughness,
@@ -84,11 +83,9 @@ fn render(
         }),
     };
     let script = dir.join("scene.py");
-    let main = (
-        "material_scene.py",
-        include_str!("blender/material_scene.py"),
-    );
-    std::fs::write(&script, assemble_parts(&document, &[FURNACE_PART, main])).unwrap();
+    let main = include_str!("blender/material_scene.py");
+    let text = assemble_with_main(&document, "material_scene.py", main).unwrap();
+    std::fs::write(&script, text).unwrap();
     let run = Run {
         blender: &blender,
         script: &script,

@@ -21,7 +21,6 @@ pub const ID: &str = "gloffuse";
 pub const LIBRARY_FOLDER: &str = "library";
 pub const LIBRARY_FILE: &str = "gloffuse.blend";
 
-const ADDON: &str = include_str!("../../blender_scripts/extension/__init__.py");
 const LICENSE: &str = include_str!("../../LICENSE");
 
 /// The manifest. `blender_version_min` is the Blender that saved the library: an older one
@@ -73,9 +72,10 @@ pub fn can_build(built_with: BlenderVersion) -> Result<(), Error> {
 pub fn package(blend: &[u8], catalogs: &str, built_with: BlenderVersion) -> Result<Vec<u8>, Error> {
     can_build(built_with)?;
     let manifest = manifest(built_with);
+    let addon = super::bundle::addon();
     let files: [(String, &[u8]); 5] = [
         ("blender_manifest.toml".into(), manifest.as_bytes()),
-        ("__init__.py".into(), ADDON.as_bytes()),
+        ("__init__.py".into(), addon.as_bytes()),
         ("LICENSE".into(), LICENSE.as_bytes()),
         (format!("{LIBRARY_FOLDER}/{LIBRARY_FILE}"), blend),
         (

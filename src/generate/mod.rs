@@ -1,8 +1,10 @@
 //! ③ Generate: the node groups as a Python script, a new .blend, or into an existing .blend.
-//! `params` is the parameter document, `script` assembles the Python, `blend` checks what
+//! `params` is the parameter document, `bundle` turns the Blender-side Python package into
+//! single-file scripts, `script` assembles a job's script, `blend` checks what
 //! Blender wrote.
 
 pub mod blend;
+pub mod bundle;
 pub mod catalogs;
 pub mod extension;
 pub mod params;
@@ -11,7 +13,7 @@ pub mod script;
 pub use params::{
     ColorModel, Curves, GenerateParams, GroupSpec, Mode, correction_group_name, shader_group_name,
 };
-pub use script::{Job, assemble, assemble_parts};
+pub use script::{Job, assemble, assemble_with_main};
 
 use serde::Serialize;
 use std::ffi::OsString;

@@ -1,5 +1,6 @@
-//! Generated Python: a header holding one JSON parameter document, then the parts of the
-//! Blender-side library in a fixed order, then the main of the job.
+//! Generated Python: a header holding one JSON parameter document, then the modules of
+//! the Blender-side package a job needs in the order their imports give (see
+//! [`super::bundle`]), then the call of the job's main on the document.
 //!
 //! The parameter document is encoded by serde_json twice: once as JSON, then as a JSON
 //! string literal, which is also a valid Python string literal. No user text is ever
@@ -7,43 +8,9 @@
 
 use serde::Serialize;
 
-/// The library parts, in the order they are concatenated: each defines functions only,
-/// and may use what the parts before it define (see `docs/ARCHITECTURE.md`).
-pub const PARTS: [(&str, &str); 9] = [
-    ("compat.py", include_str!("../../blender_scripts/compat.py")),
-    ("params.py", include_str!("../../blender_scripts/params.py")),
-    ("nodes.py", include_str!("../../blender_scripts/nodes.py")),
-    (
-        "roughness_groups.py",
-        include_str!("../../blender_scripts/roughness_groups.py"),
-    ),
-    (
-        "normal_group.py",
-        include_str!("../../blender_scripts/normal_group.py"),
-    ),
-    (
-        "view_groups.py",
-        include_str!("../../blender_scripts/view_groups.py"),
-    ),
-    (
-        "layered_groups.py",
-        include_str!("../../blender_scripts/layered_groups.py"),
-    ),
-    ("groups.py", include_str!("../../blender_scripts/groups.py")),
-    (
-        "runtime.py",
-        include_str!("../../blender_scripts/runtime.py"),
-    ),
-];
+use super::bundle::{self, BundleError, Part};
 
-/// The furnace scene (world, camera, spheres, render settings, EXR output): a part of the
-/// scripts that render, after [`PARTS`].
-pub const FURNACE_PART: (&str, &str) = (
-    "furnace.py",
-    include_str!("../../blender_scripts/furnace.py"),
-);
-
-/// What a script does when it runs: the parts appended after the library, main last.
+/// What a script does when it runs: which module of the package is its main.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Job {
     /// Build (or update) the node groups in the open or named .blend, and save it.
@@ -53,39 +20,36 @@ pub enum Job {
 }
 
 impl Job {
-    /// The job's parts after [`PARTS`], its main last.
-    pub fn parts(self) -> Vec<(&'static str, &'static str)> {
+    /// The package module that defines the job's `main(document_text)`.
+    pub fn module(self) -> &'static str {
         match self {
-            Job::Generate => vec![
-                (
-                    "previews.py",
-                    include_str!("../../blender_scripts/previews.py"),
-                ),
-                (
-                    "generate_main.py",
-                    include_str!("../../blender_scripts/generate_main.py"),
-                ),
-            ],
-            Job::Furnace => vec![
-                FURNACE_PART,
-                (
-                    "furnace_main.py",
-                    include_str!("../../blender_scripts/furnace_main.py"),
-                ),
-            ],
+            Job::Generate => "generate",
+            Job::Furnace => "furnace_job",
         }
     }
 }
 
-/// The full script of a job: header with the parameter literal, the library parts, then
-/// the job's own parts.
+/// The full script of a job: header with the parameter literal, the modules its main
+/// imports, its main, and the call of `main(GLOFFUSE_PARAMS)`.
 pub fn assemble(params: &impl Serialize, job: Job) -> String {
-    assemble_parts(params, &job.parts())
+    let parts = bundle::bundle(job.module()).expect("the embedded package bundles");
+    script(params, &parts)
 }
 
-/// A script of the library parts followed by `parts` (their names label them in the
-/// script): how every script is made, and how tests run a main of their own.
-pub fn assemble_parts(params: &impl Serialize, parts: &[(&str, &str)]) -> String {
+/// A script whose main is the module `text` (labelled `name`, not part of the package:
+/// how tests run a main of their own). Its imports, `from gloffuse_blender.x import …`
+/// or `from .x import …`, are resolved as the package's own are; it defines
+/// `main(document_text)`.
+pub fn assemble_with_main(
+    params: &impl Serialize,
+    name: &str,
+    text: &str,
+) -> Result<String, BundleError> {
+    let module = name.strip_suffix(".py").unwrap_or(name);
+    Ok(script(params, &bundle::bundle_with(module, text)?))
+}
+
+fn script(params: &impl Serialize, parts: &[Part]) -> String {
     let document = serde_json::to_string(params).expect("parameters serialise");
     let literal = serde_json::to_string(&document).expect("a string serialises");
     let mut s = format!(
@@ -94,12 +58,10 @@ pub fn assemble_parts(params: &impl Serialize, parts: &[(&str, &str)]) -> String
          GLOFFUSE_PARAMS = {literal}\n",
         env!("CARGO_PKG_VERSION")
     );
-    for &(name, text) in PARTS.iter().chain(parts) {
-        s.push_str(&format!("\n# ======== gloffuse part: {name} ========\n"));
-        s.push_str(text);
-        if !text.ends_with('\n') {
-            s.push('\n');
-        }
-    }
+    s.push_str(&bundle::concatenate(parts));
+    s.push_str(
+        "\n# ======== gloffuse: run the job on the parameter document ========\n\
+         if __name__ == \"__main__\":\n    main(GLOFFUSE_PARAMS)\n",
+    );
     s
 }

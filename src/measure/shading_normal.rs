@@ -5,7 +5,7 @@
 //! (`docs/PHYSICS.md` §7). A view gain `1/E(μ, r)` must read μ from the raised normal.
 //!
 //! This is the reference the node groups' version of the same rule (`Gloffuse Shading
-//! Normal`, built by `blender_scripts/normal_group.py`) is tested against.
+//! Normal`, built by `blender/gloffuse_blender/normal_group.py`) is tested against.
 
 use glam::DVec3;
 

@@ -1,7 +1,7 @@
 # ---------------------------------------------------------------------------
-# material_scene.py: the main of the tests' "real material" scene, appended by
-# tests/materials_e2e.rs after the library parts and furnace.py (so it builds
-# the groups and the world exactly as gloffuse does).
+# material_scene.py: the main of the tests' "real material" scene, bundled by
+# tests/materials_e2e.rs with the gloffuse_blender modules it imports (so it
+# builds the groups and the world exactly as gloffuse does).
 #
 # A white furnace (in the scene section's "engine", Cycles by default), but not a lab sphere: a perspective camera, an off-centre
 # smooth sphere whose normal is tilted by a Noise texture (a procedural normal
@@ -25,7 +25,13 @@ import os
 import sys
 
 import bpy
-import bmesh
+
+from gloffuse_blender.compat import blender_version_string, compat_camera_rays_only, compat_node_tree
+from gloffuse_blender.furnace import furnace_render_settings, furnace_world, render_sweep
+from gloffuse_blender.groups import build_all
+from gloffuse_blender.meshes import sphere_mesh
+from gloffuse_blender.params import resolve_params
+from gloffuse_blender.runtime import result_line, run_main
 
 
 def scene_section(document):
@@ -84,7 +90,7 @@ def encoded(tree, vector):
 
 def variant_material(scene, variant):
     material = bpy.data.materials.new("Scene %s" % variant["name"])
-    tree = compat_node_tree(material)  # noqa: F821 -- compat.py
+    tree = compat_node_tree(material)
     tree.nodes.clear()
     nodes, links = tree.nodes, tree.links
     output = nodes.new("ShaderNodeOutputMaterial")
@@ -145,8 +151,8 @@ def build_scene(scene):
     engine = scene.get("engine", "cycles")
     settings = {"engine": engine, "cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
     # The world first: some of EEVEE's settings are the world's.
-    render_scene.world = furnace_world()  # noqa: F821 -- furnace.py
-    furnace_render_settings(render_scene, settings, 1, 1)  # noqa: F821 -- furnace.py
+    render_scene.world = furnace_world()
+    furnace_render_settings(render_scene, settings, 1, 1)
     # A point-like pixel filter: every sample of a pixel hits the same point.
     if engine == "cycles":
         render_scene.cycles.filter_width = 0.01
@@ -161,27 +167,19 @@ def build_scene(scene):
     render_scene.collection.objects.link(camera)
     render_scene.camera = camera
 
-    mesh = bpy.data.meshes.new("Scene sphere")
-    bm = bmesh.new()
-    compat_uv_sphere(bm, 1.0, 96, 48)  # noqa: F821 -- compat.py
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = True
-    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
-    mesh.materials.append(None)
+    mesh = sphere_mesh("Scene sphere", 1.0, 96, 48)
     sphere = bpy.data.objects.new("Scene sphere", mesh)
     sphere.location = (0.45, 0.0, 0.25)
     render_scene.collection.objects.link(sphere)
-    compat_camera_rays_only(sphere)  # noqa: F821 -- compat.py
+    compat_camera_rays_only(sphere)
     return render_scene, sphere
 
 
-def scene_main():
-    document = json.loads(GLOFFUSE_PARAMS)  # noqa: F821 -- the generated header
+def scene_main(document_text):
+    document = json.loads(document_text)
     scene = scene_section(document)
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    build_all(resolve_params(document))  # noqa: F821 -- groups.py, params.py
+    build_all(resolve_params(document))
     render_scene, sphere = build_scene(scene)
     written = []
     for variant in scene["variants"]:
@@ -190,14 +188,14 @@ def scene_main():
         if render_scene.render.engine == "CYCLES":
             render_scene.cycles.samples = scene["probe_samples"] if probe else scene["samples"]
         path = os.path.join(scene["output_dir"], variant["name"] + ".exr")
-        render_sweep(path)  # noqa: F821 -- furnace.py
+        render_sweep(path)
         written.append(path)
-    print(result_line({  # noqa: F821 -- runtime.py
-        "blender_version": blender_version_string(),  # noqa: F821 -- compat.py
+    print(result_line({
+        "blender_version": blender_version_string(),
         "written": written,
     }))
     sys.stdout.flush()
 
 
-if __name__ == "__main__":
-    run_main(scene_main)  # noqa: F821 -- runtime.py
+def main(document_text):
+    run_main(lambda: scene_main(document_text))

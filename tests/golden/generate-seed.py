@@ -8,10 +8,9 @@ GLOFFUSE_PARAMS = "{\"gloffuse_version\":\"0.1.0\",\"height_correlated_from\":[3
 # Blender versions gloffuse supports (3.4 .. 5.0; the binary, its Text Editor,
 # or the `bpy` module) lives here and nowhere else.
 #
-# One part of the script the gloffuse binary concatenates: header
-# (GLOFFUSE_PARAMS), compat.py, params.py, nodes.py, roughness_groups.py,
-# normal_group.py, view_groups.py, layered_groups.py, groups.py, runtime.py, then a main (generate_main.py or
-# furnace_main.py). It defines functions and constants only.
+# A module of the gloffuse_blender package; it imports none of the others.
+# Functions and constants only. Every Blender version check of the package
+# (bpy.app.version, or a feature test standing for one) is here.
 # ---------------------------------------------------------------------------
 import bpy
 import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
@@ -233,7 +232,7 @@ def set_parent(node, frame):
     node.parent = frame
 
 
-# --- furnace scene (used by furnace_main.py) -----------------------------------
+# --- scenes (furnace.py, meshes.py, previews.py) --------------------------------
 
 def compat_node_tree(id_block):
     """The node tree of a world or material, creating it where needed.
@@ -290,6 +289,14 @@ def compat_exr_settings(settings):
         settings.use_preview = False
     if hasattr(settings, "color_management"):
         settings.color_management = "FOLLOW_SCENE"
+
+
+def compat_png_settings(settings):
+    """PNG, RGBA (the previews). 5.0 needs media_type before file_format."""
+    if hasattr(settings, "media_type"):
+        settings.media_type = "IMAGE"
+    settings.file_format = "PNG"
+    settings.color_mode = "RGBA"
 
 
 def compat_uv_sphere(bm, radius, segments, rings):
@@ -354,192 +361,6 @@ def compat_eevee_furnace(scene, world, samples):
         eevee.use_gtao = False
         eevee.use_bloom = False
 
-# ======== gloffuse part: params.py ========
-# ---------------------------------------------------------------------------
-# gloffuse params.py: checks the parameter document (GLOFFUSE_PARAMS) before
-# anything is built, and says what is wrong with it.
-#
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only; uses
-# max_name_bytes() from compat.py.
-#
-#   load_params(text) -> dict          parse the parameter JSON and resolve it
-#   resolve_params(document) -> params the document as the builders read it:
-#                                      each group with the fields of the masking
-#                                      family of the Blender this runs in
-#   validate_params(params) -> params  raise ValueError saying what is wrong
-# ---------------------------------------------------------------------------
-import json
-import math
-
-DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
-CURVE_VARIABLES = ("roughness", "alpha")
-MASKINGS = ("separable", "height-correlated")
-COLOR_MODELS = ("exact", "physical")
-ENGINES = ("cycles", "eevee")
-VIEW_GROUPS = ("correction_group", "shader_group", "multiscatter_group")
-
-
-def finite_list(value, what):
-    """value as a list of floats; ValueError unless it is a non-empty list of
-    finite numbers (booleans are not numbers here)."""
-    if not isinstance(value, list) or not value:
-        raise ValueError("%s must be a non-empty list of numbers" % what)
-    out = []
-    for item in value:
-        if isinstance(item, bool) or not isinstance(item, (int, float)) \
-                or not math.isfinite(float(item)):
-            raise ValueError("%s holds %r, which is not a finite number" % (what, item))
-        out.append(float(item))
-    return out
-
-
-def _name(value, where, limit, seen=None):
-    """A node-group or image name: a non-empty string within Blender's limit,
-    and (with `seen`) not used twice."""
-    if not isinstance(value, str) or not value.strip():
-        raise ValueError("%s must be a non-empty string" % where)
-    if len(value.encode("utf-8")) > limit:
-        raise ValueError("%s %r is longer than Blender's %d-byte name limit"
-                         % (where, value, limit))
-    if seen is not None:
-        if value in seen:
-            raise ValueError("%s %r is used twice" % (where, value))
-        seen.add(value)
-
-
-def resolve_params(document):
-    """The parameter document as the builders read it. The document carries,
-    per group, one entry in "families" per masking family; this picks the one
-    of the Blender the script runs in (or the only one there is) and copies its
-    curve, description, coefficients source, image and table into the group."""
-    if not isinstance(document, dict):
-        raise ValueError("the parameter document must be a JSON object")
-    first = document.get("height_correlated_from")
-    if not (isinstance(first, list) and len(first) == 2
-            and all(isinstance(v, int) and not isinstance(v, bool) for v in first)):
-        raise ValueError("height_correlated_from must be [major, minor], got %r" % (first,))
-    masking = masking_family(first)
-    groups = document.get("groups")
-    if not isinstance(groups, list) or not groups:
-        raise ValueError("the parameter document needs a non-empty 'groups' list")
-    resolved = []
-    for index, spec in enumerate(groups):
-        where = "groups[%d]" % index
-        if not isinstance(spec, dict):
-            raise ValueError("%s must be an object" % where)
-        families = spec.get("families")
-        if not isinstance(families, list) or not families \
-                or not all(isinstance(f, dict) for f in families):
-            raise ValueError("%s.families must be a non-empty list of objects" % where)
-        for family in families:
-            if family.get("masking") not in MASKINGS:
-                raise ValueError("%s.families: masking %r is not one of %s"
-                                 % (where, family.get("masking"), ", ".join(MASKINGS)))
-        chosen = [f for f in families if f["masking"] == masking] or families
-        if len(chosen) != 1:
-            raise ValueError("%s.families holds %d entries for %s masking; expected one"
-                             % (where, len(chosen), masking))
-        family = chosen[0]
-        group = {key: value for key, value in spec.items() if key != "families"}
-        for key in ("masking", "curve", "description", "coefficients_source"):
-            group[key] = family.get(key)
-        if isinstance(spec.get("view"), dict):
-            view = dict(spec["view"])
-            view["image"] = family.get("image")
-            view["table"] = family.get("table")
-            group["view"] = view
-        if spec.get("layered_group") is not None:
-            group["layered"] = {
-                "shader_group": spec["layered_group"],
-                "image": family.get("image"), "table": family.get("table"),
-                "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
-            }
-        resolved.append(group)
-    params = {key: value for key, value in document.items() if key != "groups"}
-    params["groups"] = resolved
-    return validate_params(params)
-
-
-def validate_params(params):
-    """Check the resolved parameters; raise ValueError saying what is wrong."""
-    if not isinstance(params, dict):
-        raise ValueError("the parameter document must be a JSON object")
-    if params.get("color_model", "exact") not in COLOR_MODELS:
-        raise ValueError("color_model is %r; expected one of %s"
-                         % (params.get("color_model"), ", ".join(COLOR_MODELS)))
-    groups = params.get("groups")
-    if not isinstance(groups, list) or not groups:
-        raise ValueError("the parameter document needs a non-empty 'groups' list")
-    limit = max_name_bytes()
-    seen = set()
-    normals = set()
-    for index, spec in enumerate(groups):
-        where = "groups[%d]" % index
-        if not isinstance(spec, dict):
-            raise ValueError("%s must be an object" % where)
-        if spec.get("distribution") not in DISTRIBUTIONS:
-            raise ValueError("%s.distribution is %r; expected one of %s"
-                             % (where, spec.get("distribution"), ", ".join(DISTRIBUTIONS)))
-        for key in ("correction_group", "shader_group"):
-            _name(spec.get(key), "%s.%s" % (where, key), limit, seen)
-        if spec.get("engine", "cycles") not in ENGINES:
-            raise ValueError("%s.engine is %r; expected one of %s"
-                             % (where, spec.get("engine"), ", ".join(ENGINES)))
-        view = spec.get("view")
-        if (view is not None or spec.get("layered") is not None) \
-                and spec.get("normal_group") not in normals:
-            # One normal group serves every spec of an engine.
-            _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
-            normals.add(spec["normal_group"])
-        if view is not None:
-            if not isinstance(view, dict):
-                raise ValueError("%s.view must be an object" % where)
-            present = [key for key in VIEW_GROUPS if view.get(key) is not None]
-            if not present:
-                raise ValueError("%s.view names none of %s" % (where, ", ".join(VIEW_GROUPS)))
-            for key in present:
-                _name(view[key], "%s.view.%s" % (where, key), limit, seen)
-            _name(view.get("image"), "%s.view.image" % where, limit)
-            table = view.get("table")
-            if not isinstance(table, dict) or not all(
-                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("width", "height")):
-                raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
-        layered = spec.get("layered")
-        if layered is not None:
-            if not isinstance(layered, dict):
-                raise ValueError("%s.layered must be an object" % where)
-            _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
-            for key in ("image", "coat_image"):
-                _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
-            coat = layered.get("coat_table")
-            if not isinstance(coat, dict) or not all(
-                    isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
-                raise ValueError("%s.layered.coat_table needs integer size and slices of at "
-                                 "least 2" % where)
-            if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
-                raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
-        for key in ("description", "coefficients_source"):
-            if not isinstance(spec.get(key, ""), str):
-                raise ValueError("%s.%s must be a string" % (where, key))
-        curve = spec.get("curve")
-        if not isinstance(curve, dict):
-            raise ValueError("%s.curve must be an object" % where)
-        if curve.get("variable") not in CURVE_VARIABLES:
-            raise ValueError("%s.curve.variable is %r; expected 'roughness' or 'alpha'"
-                             % (where, curve.get("variable")))
-        for key in ("numerator", "denominator"):
-            coeffs = finite_list(curve.get(key), "%s.curve.%s" % (where, key))
-            if not any(coeffs):
-                raise ValueError("%s.curve.%s is identically zero" % (where, key))
-    return params
-
-
-def load_params(text):
-    """Parse the JSON parameter document and resolve it for this Blender."""
-    return resolve_params(json.loads(text))
-
 # ======== gloffuse part: nodes.py ========
 # ---------------------------------------------------------------------------
 # gloffuse nodes.py: node-building helpers shared by the roughness-only and
@@ -547,12 +368,10 @@ def load_params(text):
 # reusing a group in place, its sockets, Math nodes, the clamped roughness,
 # frames and descriptions.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only; every version
-# difference it meets goes through compat.py.
+# A module of the gloffuse_blender package. Functions and constants only;
+# every version difference it meets goes through compat.py.
 # ---------------------------------------------------------------------------
-import bpy
+
 
 # Layout of the generated nodes (Blender node-editor units).
 NODE_WIDTH = 180.0
@@ -870,15 +689,419 @@ def asset_fields(params, kind):
         "copyright": params.get("asset_copyright"),
     }
 
+# ======== gloffuse part: normal_group.py ========
+# ---------------------------------------------------------------------------
+# gloffuse normal_group.py: the helper group every view-dependent group uses
+# to find the normal a glossy BSDF really shades with, and its view cosine;
+# one for Cycles' groups, one for EEVEE's (spec["normal_group"]).
+#
+# Cycles never hands a bump or normal-map normal straight to a glossy lobe: if
+# the mirror reflection about N would dip below the true surface, it first
+# raises N towards the geometric normal Ng (docs/PHYSICS.md §7). A view gain
+# 1 / E(mu, r) must read mu from that raised normal. The group rebuilds, with
+# Math nodes, the rule of the Blender it is built in (compat.py's
+# valid_reflection_rule): 3.0-3.5's ensure_valid_reflection (two candidate
+# roots, checked) or 3.6+'s ensure_valid_specular_reflection (one closed-form
+# root), and from 4.1 it honours the material's Bump Map Correction through an
+# input of the same name. EEVEE raises nothing: its group passes the normal
+# on and clamps the view cosine to [0, 1], as EEVEE reads its table.
+#
+# A module of the gloffuse_blender package. Functions and constants only.
+# ---------------------------------------------------------------------------
+
+NORMAL_INPUT = {
+    "in_out": "INPUT", "name": "Normal", "type": "NodeSocketVector", "hide_value": True,
+    "description": "Shading normal (bump or normal map); unconnected means the surface's own normal"}
+
+BUMP_MAP_CORRECTION_INPUT = {
+    "in_out": "INPUT", "name": "Bump Map Correction", "type": "NodeSocketFloat",
+    "subtype": "FACTOR", "default": 1.0, "min": 0.0, "max": 1.0,
+    "description": "1 as the material's Settings > Bump Map Correction is on (the default); "
+                   "set 0 where it is off"}
+
+
+def is_eevee(spec):
+    """Are the spec's groups calibrated for EEVEE (which shades with a bump
+    normal as it is) rather than Cycles (which raises it)?"""
+    return spec.get("engine", "cycles") == "eevee"
+
+
+def bump_map_correction_inputs(spec):
+    """The Bump Map Correction input, for Cycles' groups in the Blenders that
+    have the setting (it switches Cycles' raising of the normal off; EEVEE
+    never raises it)."""
+    return [BUMP_MAP_CORRECTION_INPUT] if has_bump_map_correction() and not is_eevee(spec) else []
+
+
+def normal_group_sockets(spec):
+    return [NORMAL_INPUT] + bump_map_correction_inputs(spec) + [
+        {"in_out": "OUTPUT", "name": "Normal", "type": "NodeSocketVector",
+         "description": "The normal %s glossy BSDF shades with"
+                        % ("EEVEE's" if is_eevee(spec) else "Cycles'")},
+        {"in_out": "OUTPUT", "name": "View Cosine", "type": "NodeSocketFloat",
+         "description": "mu = N' · I, the view cosine at that normal"},
+    ]
+
+
+def _raised_normal_3_6(chain, I, Ng, X, Ix, Iz, t, a):
+    """3.6+: the one root N'z² = (b ± √(b² − 4ac)) / 4a, + where Ix < 0."""
+    b = chain.math("MULTIPLY", "b = 2 (a + Iz t)", chain.math("MULTIPLY_ADD", "a + Iz t", Iz, t, a), 2.0)
+    s = chain.math("ADD", "t + Iz", t, Iz)
+    c = chain.math("MULTIPLY", "c = (t + Iz)²", s, s)
+    bb = chain.math("MULTIPLY", "b²", b, b)
+    ac4 = chain.math("MULTIPLY", "4ac", chain.math("MULTIPLY", "ac", a, c), 4.0)
+    # Math's Square Root is Cycles' safe_sqrtf: 0 below 0.
+    root = chain.math("SQRT", "√(b² − 4ac)", chain.math("SUBTRACT", "b² − 4ac", bb, ac4))
+    sign = chain.math("MULTIPLY_ADD", "±: +1 if Ix < 0",
+                      chain.math("LESS_THAN", "Ix < 0", Ix, 0.0), 2.0, -1.0)
+    top = chain.math("MULTIPLY_ADD", "b ± root", sign, root, b)
+    nz2 = chain.math("DIVIDE", "N'z² = (b ± root) / 4a",
+                     chain.math("MULTIPLY", "(b ± root) / 4", top, 0.25), a)
+    nx = chain.math("SQRT", "N'x", chain.math("SUBTRACT", "1 − N'z²", 1.0, nz2))
+    nz = chain.math("SQRT", "N'z", nz2)
+    return chain.vector("ADD", "N' = N'x X + N'z Ng",
+                        chain.vector("SCALE", "N'x X", X, nx),
+                        chain.vector("SCALE", "N'z Ng", Ng, nz))
+
+
+def _raised_normal_3_0(chain, I, Ng, X, Ix, Iz, t, a, minus_iz):
+    """3.0-3.5: both roots N'z² = (c ± b) / 2a, each kept if it is in
+    (1e-5, 1 + 1e-5]; of two, the one whose reflection is shallower while both
+    are above 1e-5 (else the higher one); of none, Ng."""
+    fac = chain.math("DIVIDE", "fac = 0.5 / a", 0.5, a)
+    ix2 = chain.math("MULTIPLY", "Ix²", Ix, Ix)
+    b = chain.math("SQRT", "b = √(Ix² (a − t²))",
+                   chain.math("MULTIPLY", "Ix² (a − t²)", ix2,
+                              chain.math("SUBTRACT", "a − t²", a, chain.math("MULTIPLY", "t²", t, t))))
+    c = chain.math("MULTIPLY_ADD", "c = Iz t + a", Iz, t, a)
+    roots = []
+    for k, (op, text) in enumerate((("ADD", "c + b"), ("SUBTRACT", "c − b")), start=1):
+        z2 = chain.math("MULTIPLY", "N%dz² = fac (%s)" % (k, text), chain.math(op, text, c, b), fac)
+        above = chain.math("GREATER_THAN", "N%dz² > 1e-5" % k, z2, 1e-5)
+        too_high = chain.math("GREATER_THAN", "N%dz² > 1 + 1e-5" % k, z2, 1.0 + 1e-5)
+        valid = chain.math("MULTIPLY", "N%d valid" % k, above,
+                           chain.math("SUBTRACT", "not N%dz² > 1 + 1e-5" % k, 1.0, too_high))
+        x = chain.math("SQRT", "N%dx" % k, chain.math("SUBTRACT", "1 − N%dz²" % k, 1.0, z2))
+        z = chain.math("SQRT", "N%dz" % k, z2)
+        dot = chain.math("MULTIPLY_ADD", "N%d · I" % k, x, Ix, chain.math("MULTIPLY", "N%dz Iz" % k, z, Iz))
+        height = chain.math("MULTIPLY_ADD", "R%d = 2 (N%d · I) N%dz − Iz" % (k, k, k),
+                            chain.math("MULTIPLY", "(N%d · I) N%dz" % (k, k), dot, z), 2.0, minus_iz)
+        roots.append((valid, x, z, height))
+    (v1, x1, z1, r1), (v2, x2, z2, r2) = roots
+    both_up = chain.math("MULTIPLY", "R1, R2 ≥ 1e-5",
+                         chain.math("SUBTRACT", "R1 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R1 < 1e-5", r1, 1e-5)),
+                         chain.math("SUBTRACT", "R2 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R2 < 1e-5", r2, 1e-5)))
+    first_if_both = chain.mix_value("pick 1 of two", both_up,
+                                    chain.math("GREATER_THAN", "R1 > R2", r1, r2),
+                                    chain.math("LESS_THAN", "R1 < R2", r1, r2))
+    both = chain.math("MULTIPLY", "both valid", v1, v2)
+    first = chain.mix_value("pick 1", both, v1, first_if_both)
+    nx = chain.mix_value("N'x", first, x2, x1)
+    nz = chain.mix_value("N'z", first, z2, z1)
+    raised = chain.vector("ADD", "N' = N'x X + N'z Ng",
+                          chain.vector("SCALE", "N'x X", X, nx),
+                          chain.vector("SCALE", "N'z Ng", Ng, nz))
+    return chain.select("N' or Ng", chain.math("MAXIMUM", "any valid", v1, v2), Ng, raised)
+
+
+def build_normal_group(spec, params):
+    """The spec's normal group: Cycles' (the raised normal) or EEVEE's (the
+    normal as given)."""
+    if is_eevee(spec):
+        return _build_eevee_normal_group(spec, params)
+    return _build_cycles_normal_group(spec, params)
+
+
+def _normal_frame(spec, label):
+    """The normal group's tree, Group Input, frame, Geometry node and a Chain
+    after it, with N = the Normal input normalised (unconnected, it arrives as
+    (0, 0, 0): the surface's own normal)."""
+    tree = reuse_or_create_group(spec["normal_group"])
+    ensure_interface(tree, normal_group_sockets(spec))
+    group_in = tree.nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+    frame = new_frame(tree, "Normal frame", short_label(label))
+    geometry = tree.nodes.new("ShaderNodeNewGeometry")
+    geometry.name = "Geometry"
+    set_parent(geometry, frame)
+    geometry.location = (FRAME_INSET, -ROW_STEP)
+    chain = Chain(tree, frame, column=1)
+    given = group_in.outputs["Normal"]
+    connected = chain.math("GREATER_THAN", "Normal connected", chain.vector("LENGTH", "|Normal|", given), 0.5)
+    N = chain.select("N", connected, geometry.outputs["Normal"], chain.vector("NORMALIZE", "Normal / |Normal|", given))
+    return tree, group_in, geometry, chain, N
+
+
+def _finish_normal_group(tree, chain, params, used, mu, description):
+    group_out = tree.nodes.new("NodeGroupOutput")
+    group_out.location = (FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 100.0, 0.0)
+    tree.links.new(used, group_out.inputs["Normal"])
+    tree.links.new(mu, group_out.inputs["View Cosine"])
+    description += " Used by gloffuse's view-dependent groups. Generated by gloffuse %s in Blender %s." % (
+        params.get("gloffuse_version", "?"), blender_version_string())
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", "normal"], asset_fields(params, "helper"))
+    return tree
+
+
+def _build_eevee_normal_group(spec, params):
+    """Normal -> Normal, View Cosine: EEVEE shades a glossy lobe with the bump
+    or normal-map normal as it is, and reads its split-sum table at N · I
+    clamped to [0, 1] (measured: a strongly bumped sphere renders E(max(N · I,
+    0)) pixel by pixel in 4.5 and 5.0, and in 3.4 wherever N · I >= 0)."""
+    tree, group_in, geometry, chain, N = _normal_frame(
+        spec, "EEVEE: N as given, mu = clamp(N · I, 0, 1)")
+    mu = chain.clamp("View Cosine = clamp(N · I, 0, 1)",
+                     chain.vector("DOT_PRODUCT", "N · I", N, geometry.outputs["Incoming"]), 0.0, 1.0)
+    return _finish_normal_group(tree, chain, params, N, mu, (
+        "The normal EEVEE's glossy BSDF shades with: a bump or normal-map normal as it is "
+        "(or, unconnected, the surface's own), and the view cosine there, clamped to [0, 1] "
+        "as EEVEE clamps it."))
+
+
+def _build_cycles_normal_group(spec, params):
+    """Normal [, Bump Map Correction] -> Normal, View Cosine: the normal
+    Cycles' glossy BSDF shades with, and mu = N' · I."""
+    rule = valid_reflection_rule()
+    tree, group_in, geometry, chain, N = _normal_frame(
+        spec, "N raised until its mirror reflection clears the surface (Cycles %s rule)" % rule)
+    I, Ng = geometry.outputs["Incoming"], geometry.outputs["True Normal"]
+    n_dot_ng = chain.vector("DOT_PRODUCT", "N · Ng", N, Ng)
+    iz = chain.vector("DOT_PRODUCT", "Iz = I · Ng", I, Ng)
+    minus_iz = chain.math("MULTIPLY", "−Iz", iz, -1.0)
+    height = chain.math("MULTIPLY_ADD", "R · Ng = 2 (N · I)(N · Ng) − Iz",
+                        chain.math("MULTIPLY", "(N · I)(N · Ng)", chain.vector("DOT_PRODUCT", "N · I", N, I), n_dot_ng),
+                        2.0, minus_iz)
+    t = chain.math("MINIMUM", "t = min(0.9 Iz, 0.01)", chain.math("MULTIPLY", "0.9 Iz", iz, 0.9), 0.01)
+    needed = chain.math("LESS_THAN", "R · Ng < t", height, t)
+    if has_bump_map_correction():
+        needed = chain.math("MULTIPLY", "and Bump Map Correction", needed,
+                            group_in.outputs["Bump Map Correction"])
+    X = chain.vector("NORMALIZE", "X = N − (N · Ng) Ng, normalised",
+                     chain.vector("SUBTRACT", "N − (N · Ng) Ng", N, chain.vector("SCALE", "(N · Ng) Ng", Ng, n_dot_ng)))
+    ix = chain.vector("DOT_PRODUCT", "Ix = I · X", I, X)
+    a = chain.math("MULTIPLY_ADD", "a = Ix² + Iz²", ix, ix, chain.math("MULTIPLY", "Iz²", iz, iz))
+    if rule == "3.6":
+        raised = _raised_normal_3_6(chain, I, Ng, X, ix, iz, t, a)
+    else:
+        raised = _raised_normal_3_0(chain, I, Ng, X, ix, iz, t, a, minus_iz)
+    used = chain.select("Normal used", needed, N, raised)
+    mu = chain.vector("DOT_PRODUCT", "View Cosine = N' · I", used, I)
+    return _finish_normal_group(tree, chain, params, used, mu, (
+        "The normal Cycles' glossy BSDF really shades with: a bump or normal-map normal "
+        "(or, unconnected, the surface's own) raised towards the true normal wherever its "
+        "mirror reflection would dip below the surface (Blender %s's rule%s), and the view "
+        "cosine at it." % (rule, ", honouring Bump Map Correction" if has_bump_map_correction() else "")))
+
+
+def normal_group_node(tree, normal_tree, group_in, location, frame=None):
+    """A node of the normal group fed by the Group Input's Normal (and Bump Map
+    Correction); returns it."""
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = normal_tree
+    node.name = "Shading normal"
+    node.label = short_label(normal_tree.name)
+    node.width = 240.0
+    if frame is not None:
+        set_parent(node, frame)
+    node.location = location
+    for name in ("Normal", "Bump Map Correction"):
+        if name in node.inputs:
+            tree.links.new(group_in.outputs[name], node.inputs[name])
+    return node
+
+# ======== gloffuse part: params.py ========
+# ---------------------------------------------------------------------------
+# gloffuse params.py: checks the parameter document (GLOFFUSE_PARAMS) before
+# anything is built, and says what is wrong with it.
+#
+# A module of the gloffuse_blender package. Functions and constants only; uses
+# max_name_bytes() and masking_family() from compat.py.
+#
+#   load_params(text) -> dict          parse the parameter JSON and resolve it
+#   resolve_params(document) -> params the document as the builders read it:
+#                                      each group with the fields of the masking
+#                                      family of the Blender this runs in
+#   validate_params(params) -> params  raise ValueError saying what is wrong
+# ---------------------------------------------------------------------------
+import json
+import math
+
+
+DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
+CURVE_VARIABLES = ("roughness", "alpha")
+MASKINGS = ("separable", "height-correlated")
+COLOR_MODELS = ("exact", "physical")
+ENGINES = ("cycles", "eevee")
+VIEW_GROUPS = ("correction_group", "shader_group", "multiscatter_group")
+
+
+def finite_list(value, what):
+    """value as a list of floats; ValueError unless it is a non-empty list of
+    finite numbers (booleans are not numbers here)."""
+    if not isinstance(value, list) or not value:
+        raise ValueError("%s must be a non-empty list of numbers" % what)
+    out = []
+    for item in value:
+        if isinstance(item, bool) or not isinstance(item, (int, float)) \
+                or not math.isfinite(float(item)):
+            raise ValueError("%s holds %r, which is not a finite number" % (what, item))
+        out.append(float(item))
+    return out
+
+
+def _name(value, where, limit, seen=None):
+    """A node-group or image name: a non-empty string within Blender's limit,
+    and (with `seen`) not used twice."""
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError("%s must be a non-empty string" % where)
+    if len(value.encode("utf-8")) > limit:
+        raise ValueError("%s %r is longer than Blender's %d-byte name limit"
+                         % (where, value, limit))
+    if seen is not None:
+        if value in seen:
+            raise ValueError("%s %r is used twice" % (where, value))
+        seen.add(value)
+
+
+def resolve_params(document):
+    """The parameter document as the builders read it. The document carries,
+    per group, one entry in "families" per masking family; this picks the one
+    of the Blender the script runs in (or the only one there is) and copies its
+    curve, description, coefficients source, image and table into the group."""
+    if not isinstance(document, dict):
+        raise ValueError("the parameter document must be a JSON object")
+    first = document.get("height_correlated_from")
+    if not (isinstance(first, list) and len(first) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) for v in first)):
+        raise ValueError("height_correlated_from must be [major, minor], got %r" % (first,))
+    masking = masking_family(first)
+    groups = document.get("groups")
+    if not isinstance(groups, list) or not groups:
+        raise ValueError("the parameter document needs a non-empty 'groups' list")
+    resolved = []
+    for index, spec in enumerate(groups):
+        where = "groups[%d]" % index
+        if not isinstance(spec, dict):
+            raise ValueError("%s must be an object" % where)
+        families = spec.get("families")
+        if not isinstance(families, list) or not families \
+                or not all(isinstance(f, dict) for f in families):
+            raise ValueError("%s.families must be a non-empty list of objects" % where)
+        for family in families:
+            if family.get("masking") not in MASKINGS:
+                raise ValueError("%s.families: masking %r is not one of %s"
+                                 % (where, family.get("masking"), ", ".join(MASKINGS)))
+        chosen = [f for f in families if f["masking"] == masking] or families
+        if len(chosen) != 1:
+            raise ValueError("%s.families holds %d entries for %s masking; expected one"
+                             % (where, len(chosen), masking))
+        family = chosen[0]
+        group = {key: value for key, value in spec.items() if key != "families"}
+        for key in ("masking", "curve", "description", "coefficients_source"):
+            group[key] = family.get(key)
+        if isinstance(spec.get("view"), dict):
+            view = dict(spec["view"])
+            view["image"] = family.get("image")
+            view["table"] = family.get("table")
+            group["view"] = view
+        if spec.get("layered_group") is not None:
+            group["layered"] = {
+                "shader_group": spec["layered_group"],
+                "image": family.get("image"), "table": family.get("table"),
+                "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
+            }
+        resolved.append(group)
+    params = {key: value for key, value in document.items() if key != "groups"}
+    params["groups"] = resolved
+    return validate_params(params)
+
+
+def validate_params(params):
+    """Check the resolved parameters; raise ValueError saying what is wrong."""
+    if not isinstance(params, dict):
+        raise ValueError("the parameter document must be a JSON object")
+    if params.get("color_model", "exact") not in COLOR_MODELS:
+        raise ValueError("color_model is %r; expected one of %s"
+                         % (params.get("color_model"), ", ".join(COLOR_MODELS)))
+    groups = params.get("groups")
+    if not isinstance(groups, list) or not groups:
+        raise ValueError("the parameter document needs a non-empty 'groups' list")
+    limit = max_name_bytes()
+    seen = set()
+    normals = set()
+    for index, spec in enumerate(groups):
+        where = "groups[%d]" % index
+        if not isinstance(spec, dict):
+            raise ValueError("%s must be an object" % where)
+        if spec.get("distribution") not in DISTRIBUTIONS:
+            raise ValueError("%s.distribution is %r; expected one of %s"
+                             % (where, spec.get("distribution"), ", ".join(DISTRIBUTIONS)))
+        for key in ("correction_group", "shader_group"):
+            _name(spec.get(key), "%s.%s" % (where, key), limit, seen)
+        if spec.get("engine", "cycles") not in ENGINES:
+            raise ValueError("%s.engine is %r; expected one of %s"
+                             % (where, spec.get("engine"), ", ".join(ENGINES)))
+        view = spec.get("view")
+        if (view is not None or spec.get("layered") is not None) \
+                and spec.get("normal_group") not in normals:
+            # One normal group serves every spec of an engine.
+            _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
+            normals.add(spec["normal_group"])
+        if view is not None:
+            if not isinstance(view, dict):
+                raise ValueError("%s.view must be an object" % where)
+            present = [key for key in VIEW_GROUPS if view.get(key) is not None]
+            if not present:
+                raise ValueError("%s.view names none of %s" % (where, ", ".join(VIEW_GROUPS)))
+            for key in present:
+                _name(view[key], "%s.view.%s" % (where, key), limit, seen)
+            _name(view.get("image"), "%s.view.image" % where, limit)
+            table = view.get("table")
+            if not isinstance(table, dict) or not all(
+                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("width", "height")):
+                raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
+        layered = spec.get("layered")
+        if layered is not None:
+            if not isinstance(layered, dict):
+                raise ValueError("%s.layered must be an object" % where)
+            _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
+            for key in ("image", "coat_image"):
+                _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
+            coat = layered.get("coat_table")
+            if not isinstance(coat, dict) or not all(
+                    isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
+                raise ValueError("%s.layered.coat_table needs integer size and slices of at "
+                                 "least 2" % where)
+            if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
+                raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
+        for key in ("description", "coefficients_source"):
+            if not isinstance(spec.get(key, ""), str):
+                raise ValueError("%s.%s must be a string" % (where, key))
+        curve = spec.get("curve")
+        if not isinstance(curve, dict):
+            raise ValueError("%s.curve must be an object" % where)
+        if curve.get("variable") not in CURVE_VARIABLES:
+            raise ValueError("%s.curve.variable is %r; expected 'roughness' or 'alpha'"
+                             % (where, curve.get("variable")))
+        for key in ("numerator", "denominator"):
+            coeffs = finite_list(curve.get(key), "%s.curve.%s" % (where, key))
+            if not any(coeffs):
+                raise ValueError("%s.curve.%s is identically zero" % (where, key))
+    return params
+
+
+def load_params(text):
+    """Parse the JSON parameter document and resolve it for this Blender."""
+    return resolve_params(json.loads(text))
+
 # ======== gloffuse part: roughness_groups.py ========
 # ---------------------------------------------------------------------------
 # gloffuse roughness_groups.py: the roughness-only groups. The correction
 # group (Roughness, Color -> Color, Gain with Gain = 100 / f(x), f the fitted
 # curve) and the shader group (a Glossy BSDF whose colour goes through it).
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only.
+# A module of the gloffuse_blender package. Functions and constants only.
 #
 #   build_correction_group(spec, params) -> correction tree
 #   build_shader_group(spec, params, correction_tree) -> shader tree
@@ -1113,230 +1336,6 @@ def build_glossy_group(name, spec, params, correction_tree, description, tags, s
     mark_asset(tree, description, tags, asset_fields(params, "shader"))
     return tree
 
-# ======== gloffuse part: normal_group.py ========
-# ---------------------------------------------------------------------------
-# gloffuse normal_group.py: the helper group every view-dependent group uses
-# to find the normal a glossy BSDF really shades with, and its view cosine;
-# one for Cycles' groups, one for EEVEE's (spec["normal_group"]).
-#
-# Cycles never hands a bump or normal-map normal straight to a glossy lobe: if
-# the mirror reflection about N would dip below the true surface, it first
-# raises N towards the geometric normal Ng (docs/PHYSICS.md §7). A view gain
-# 1 / E(mu, r) must read mu from that raised normal. The group rebuilds, with
-# Math nodes, the rule of the Blender it is built in (compat.py's
-# valid_reflection_rule): 3.0-3.5's ensure_valid_reflection (two candidate
-# roots, checked) or 3.6+'s ensure_valid_specular_reflection (one closed-form
-# root), and from 4.1 it honours the material's Bump Map Correction through an
-# input of the same name. EEVEE raises nothing: its group passes the normal
-# on and clamps the view cosine to [0, 1], as EEVEE reads its table.
-#
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# layered_groups.py, groups.py, runtime.py, then a main. Functions and constants only.
-# ---------------------------------------------------------------------------
-import bpy
-
-NORMAL_INPUT = {
-    "in_out": "INPUT", "name": "Normal", "type": "NodeSocketVector", "hide_value": True,
-    "description": "Shading normal (bump or normal map); unconnected means the surface's own normal"}
-
-BUMP_MAP_CORRECTION_INPUT = {
-    "in_out": "INPUT", "name": "Bump Map Correction", "type": "NodeSocketFloat",
-    "subtype": "FACTOR", "default": 1.0, "min": 0.0, "max": 1.0,
-    "description": "1 as the material's Settings > Bump Map Correction is on (the default); "
-                   "set 0 where it is off"}
-
-
-def is_eevee(spec):
-    """Are the spec's groups calibrated for EEVEE (which shades with a bump
-    normal as it is) rather than Cycles (which raises it)?"""
-    return spec.get("engine", "cycles") == "eevee"
-
-
-def bump_map_correction_inputs(spec):
-    """The Bump Map Correction input, for Cycles' groups in the Blenders that
-    have the setting (it switches Cycles' raising of the normal off; EEVEE
-    never raises it)."""
-    return [BUMP_MAP_CORRECTION_INPUT] if has_bump_map_correction() and not is_eevee(spec) else []
-
-
-def normal_group_sockets(spec):
-    return [NORMAL_INPUT] + bump_map_correction_inputs(spec) + [
-        {"in_out": "OUTPUT", "name": "Normal", "type": "NodeSocketVector",
-         "description": "The normal %s glossy BSDF shades with"
-                        % ("EEVEE's" if is_eevee(spec) else "Cycles'")},
-        {"in_out": "OUTPUT", "name": "View Cosine", "type": "NodeSocketFloat",
-         "description": "mu = N' · I, the view cosine at that normal"},
-    ]
-
-
-def _raised_normal_3_6(chain, I, Ng, X, Ix, Iz, t, a):
-    """3.6+: the one root N'z² = (b ± √(b² − 4ac)) / 4a, + where Ix < 0."""
-    b = chain.math("MULTIPLY", "b = 2 (a + Iz t)", chain.math("MULTIPLY_ADD", "a + Iz t", Iz, t, a), 2.0)
-    s = chain.math("ADD", "t + Iz", t, Iz)
-    c = chain.math("MULTIPLY", "c = (t + Iz)²", s, s)
-    bb = chain.math("MULTIPLY", "b²", b, b)
-    ac4 = chain.math("MULTIPLY", "4ac", chain.math("MULTIPLY", "ac", a, c), 4.0)
-    # Math's Square Root is Cycles' safe_sqrtf: 0 below 0.
-    root = chain.math("SQRT", "√(b² − 4ac)", chain.math("SUBTRACT", "b² − 4ac", bb, ac4))
-    sign = chain.math("MULTIPLY_ADD", "±: +1 if Ix < 0",
-                      chain.math("LESS_THAN", "Ix < 0", Ix, 0.0), 2.0, -1.0)
-    top = chain.math("MULTIPLY_ADD", "b ± root", sign, root, b)
-    nz2 = chain.math("DIVIDE", "N'z² = (b ± root) / 4a",
-                     chain.math("MULTIPLY", "(b ± root) / 4", top, 0.25), a)
-    nx = chain.math("SQRT", "N'x", chain.math("SUBTRACT", "1 − N'z²", 1.0, nz2))
-    nz = chain.math("SQRT", "N'z", nz2)
-    return chain.vector("ADD", "N' = N'x X + N'z Ng",
-                        chain.vector("SCALE", "N'x X", X, nx),
-                        chain.vector("SCALE", "N'z Ng", Ng, nz))
-
-
-def _raised_normal_3_0(chain, I, Ng, X, Ix, Iz, t, a, minus_iz):
-    """3.0-3.5: both roots N'z² = (c ± b) / 2a, each kept if it is in
-    (1e-5, 1 + 1e-5]; of two, the one whose reflection is shallower while both
-    are above 1e-5 (else the higher one); of none, Ng."""
-    fac = chain.math("DIVIDE", "fac = 0.5 / a", 0.5, a)
-    ix2 = chain.math("MULTIPLY", "Ix²", Ix, Ix)
-    b = chain.math("SQRT", "b = √(Ix² (a − t²))",
-                   chain.math("MULTIPLY", "Ix² (a − t²)", ix2,
-                              chain.math("SUBTRACT", "a − t²", a, chain.math("MULTIPLY", "t²", t, t))))
-    c = chain.math("MULTIPLY_ADD", "c = Iz t + a", Iz, t, a)
-    roots = []
-    for k, (op, text) in enumerate((("ADD", "c + b"), ("SUBTRACT", "c − b")), start=1):
-        z2 = chain.math("MULTIPLY", "N%dz² = fac (%s)" % (k, text), chain.math(op, text, c, b), fac)
-        above = chain.math("GREATER_THAN", "N%dz² > 1e-5" % k, z2, 1e-5)
-        too_high = chain.math("GREATER_THAN", "N%dz² > 1 + 1e-5" % k, z2, 1.0 + 1e-5)
-        valid = chain.math("MULTIPLY", "N%d valid" % k, above,
-                           chain.math("SUBTRACT", "not N%dz² > 1 + 1e-5" % k, 1.0, too_high))
-        x = chain.math("SQRT", "N%dx" % k, chain.math("SUBTRACT", "1 − N%dz²" % k, 1.0, z2))
-        z = chain.math("SQRT", "N%dz" % k, z2)
-        dot = chain.math("MULTIPLY_ADD", "N%d · I" % k, x, Ix, chain.math("MULTIPLY", "N%dz Iz" % k, z, Iz))
-        height = chain.math("MULTIPLY_ADD", "R%d = 2 (N%d · I) N%dz − Iz" % (k, k, k),
-                            chain.math("MULTIPLY", "(N%d · I) N%dz" % (k, k), dot, z), 2.0, minus_iz)
-        roots.append((valid, x, z, height))
-    (v1, x1, z1, r1), (v2, x2, z2, r2) = roots
-    both_up = chain.math("MULTIPLY", "R1, R2 ≥ 1e-5",
-                         chain.math("SUBTRACT", "R1 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R1 < 1e-5", r1, 1e-5)),
-                         chain.math("SUBTRACT", "R2 ≥ 1e-5", 1.0, chain.math("LESS_THAN", "R2 < 1e-5", r2, 1e-5)))
-    first_if_both = chain.mix_value("pick 1 of two", both_up,
-                                    chain.math("GREATER_THAN", "R1 > R2", r1, r2),
-                                    chain.math("LESS_THAN", "R1 < R2", r1, r2))
-    both = chain.math("MULTIPLY", "both valid", v1, v2)
-    first = chain.mix_value("pick 1", both, v1, first_if_both)
-    nx = chain.mix_value("N'x", first, x2, x1)
-    nz = chain.mix_value("N'z", first, z2, z1)
-    raised = chain.vector("ADD", "N' = N'x X + N'z Ng",
-                          chain.vector("SCALE", "N'x X", X, nx),
-                          chain.vector("SCALE", "N'z Ng", Ng, nz))
-    return chain.select("N' or Ng", chain.math("MAXIMUM", "any valid", v1, v2), Ng, raised)
-
-
-def build_normal_group(spec, params):
-    """The spec's normal group: Cycles' (the raised normal) or EEVEE's (the
-    normal as given)."""
-    if is_eevee(spec):
-        return _build_eevee_normal_group(spec, params)
-    return _build_cycles_normal_group(spec, params)
-
-
-def _normal_frame(spec, label):
-    """The normal group's tree, Group Input, frame, Geometry node and a Chain
-    after it, with N = the Normal input normalised (unconnected, it arrives as
-    (0, 0, 0): the surface's own normal)."""
-    tree = reuse_or_create_group(spec["normal_group"])
-    ensure_interface(tree, normal_group_sockets(spec))
-    group_in = tree.nodes.new("NodeGroupInput")
-    group_in.location = (0.0, 0.0)
-    frame = new_frame(tree, "Normal frame", short_label(label))
-    geometry = tree.nodes.new("ShaderNodeNewGeometry")
-    geometry.name = "Geometry"
-    set_parent(geometry, frame)
-    geometry.location = (FRAME_INSET, -ROW_STEP)
-    chain = Chain(tree, frame, column=1)
-    given = group_in.outputs["Normal"]
-    connected = chain.math("GREATER_THAN", "Normal connected", chain.vector("LENGTH", "|Normal|", given), 0.5)
-    N = chain.select("N", connected, geometry.outputs["Normal"], chain.vector("NORMALIZE", "Normal / |Normal|", given))
-    return tree, group_in, geometry, chain, N
-
-
-def _finish_normal_group(tree, chain, params, used, mu, description):
-    group_out = tree.nodes.new("NodeGroupOutput")
-    group_out.location = (FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 100.0, 0.0)
-    tree.links.new(used, group_out.inputs["Normal"])
-    tree.links.new(mu, group_out.inputs["View Cosine"])
-    description += " Used by gloffuse's view-dependent groups. Generated by gloffuse %s in Blender %s." % (
-        params.get("gloffuse_version", "?"), blender_version_string())
-    set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", "normal"], asset_fields(params, "helper"))
-    return tree
-
-
-def _build_eevee_normal_group(spec, params):
-    """Normal -> Normal, View Cosine: EEVEE shades a glossy lobe with the bump
-    or normal-map normal as it is, and reads its split-sum table at N · I
-    clamped to [0, 1] (measured: a strongly bumped sphere renders E(max(N · I,
-    0)) pixel by pixel in 4.5 and 5.0, and in 3.4 wherever N · I >= 0)."""
-    tree, group_in, geometry, chain, N = _normal_frame(
-        spec, "EEVEE: N as given, mu = clamp(N · I, 0, 1)")
-    mu = chain.clamp("View Cosine = clamp(N · I, 0, 1)",
-                     chain.vector("DOT_PRODUCT", "N · I", N, geometry.outputs["Incoming"]), 0.0, 1.0)
-    return _finish_normal_group(tree, chain, params, N, mu, (
-        "The normal EEVEE's glossy BSDF shades with: a bump or normal-map normal as it is "
-        "(or, unconnected, the surface's own), and the view cosine there, clamped to [0, 1] "
-        "as EEVEE clamps it."))
-
-
-def _build_cycles_normal_group(spec, params):
-    """Normal [, Bump Map Correction] -> Normal, View Cosine: the normal
-    Cycles' glossy BSDF shades with, and mu = N' · I."""
-    rule = valid_reflection_rule()
-    tree, group_in, geometry, chain, N = _normal_frame(
-        spec, "N raised until its mirror reflection clears the surface (Cycles %s rule)" % rule)
-    I, Ng = geometry.outputs["Incoming"], geometry.outputs["True Normal"]
-    n_dot_ng = chain.vector("DOT_PRODUCT", "N · Ng", N, Ng)
-    iz = chain.vector("DOT_PRODUCT", "Iz = I · Ng", I, Ng)
-    minus_iz = chain.math("MULTIPLY", "−Iz", iz, -1.0)
-    height = chain.math("MULTIPLY_ADD", "R · Ng = 2 (N · I)(N · Ng) − Iz",
-                        chain.math("MULTIPLY", "(N · I)(N · Ng)", chain.vector("DOT_PRODUCT", "N · I", N, I), n_dot_ng),
-                        2.0, minus_iz)
-    t = chain.math("MINIMUM", "t = min(0.9 Iz, 0.01)", chain.math("MULTIPLY", "0.9 Iz", iz, 0.9), 0.01)
-    needed = chain.math("LESS_THAN", "R · Ng < t", height, t)
-    if has_bump_map_correction():
-        needed = chain.math("MULTIPLY", "and Bump Map Correction", needed,
-                            group_in.outputs["Bump Map Correction"])
-    X = chain.vector("NORMALIZE", "X = N − (N · Ng) Ng, normalised",
-                     chain.vector("SUBTRACT", "N − (N · Ng) Ng", N, chain.vector("SCALE", "(N · Ng) Ng", Ng, n_dot_ng)))
-    ix = chain.vector("DOT_PRODUCT", "Ix = I · X", I, X)
-    a = chain.math("MULTIPLY_ADD", "a = Ix² + Iz²", ix, ix, chain.math("MULTIPLY", "Iz²", iz, iz))
-    if rule == "3.6":
-        raised = _raised_normal_3_6(chain, I, Ng, X, ix, iz, t, a)
-    else:
-        raised = _raised_normal_3_0(chain, I, Ng, X, ix, iz, t, a, minus_iz)
-    used = chain.select("Normal used", needed, N, raised)
-    mu = chain.vector("DOT_PRODUCT", "View Cosine = N' · I", used, I)
-    return _finish_normal_group(tree, chain, params, used, mu, (
-        "The normal Cycles' glossy BSDF really shades with: a bump or normal-map normal "
-        "(or, unconnected, the surface's own) raised towards the true normal wherever its "
-        "mirror reflection would dip below the surface (Blender %s's rule%s), and the view "
-        "cosine at it." % (rule, ", honouring Bump Map Correction" if has_bump_map_correction() else "")))
-
-
-def normal_group_node(tree, normal_tree, group_in, location, frame=None):
-    """A node of the normal group fed by the Group Input's Normal (and Bump Map
-    Correction); returns it."""
-    node = tree.nodes.new("ShaderNodeGroup")
-    node.node_tree = normal_tree
-    node.name = "Shading normal"
-    node.label = short_label(normal_tree.name)
-    node.width = 240.0
-    if frame is not None:
-        set_parent(node, frame)
-    node.location = location
-    for name in ("Normal", "Bump Map Correction"):
-        if name in node.inputs:
-            tree.links.new(group_in.outputs[name], node.inputs[name])
-    return node
-
 # ======== gloffuse part: view_groups.py ========
 # ---------------------------------------------------------------------------
 # gloffuse view_groups.py: the view-dependent and multiple-scattering groups
@@ -1356,12 +1355,10 @@ def normal_group_node(tree, normal_tree, group_in, location, frame=None):
 # as Kulla and Conty (and Blender's Multiscatter GGX) do:
 # Fms = C E_avg / (1 - C (1 - E_avg)), colour C (1 + Fms (1 - E) / E).
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only; the socket lists
+# A module of the gloffuse_blender package. Functions and constants only; the socket lists
 # below extend roughness_groups.py's.
 # ---------------------------------------------------------------------------
-import bpy
+
 
 def view_correction_sockets(spec):
     """Roughness, Color, Normal [, Bump Map Correction] -> Color, Gain."""
@@ -1699,8 +1696,8 @@ def build_multiscatter_group(spec, params):
 # slices around its IOR and mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
 # from the shading-normal group (normal_group.py).
 #
-# One part of the script the gloffuse binary concatenates, after
-# view_groups.py (whose albedo_lookup, grid_cell, read_cell and bilinear it uses). Functions and constants only.
+# A module of the gloffuse_blender package; it uses view_groups.py's
+# albedo_lookup, grid_cell, read_cell and bilinear. Functions and constants only.
 # ---------------------------------------------------------------------------
 
 # An index of 1 is no coat at all; the table's last slice (coat_table.ior_max) is the top.
@@ -1821,13 +1818,12 @@ def build_layered_group(spec, params):
 # gloffuse groups.py: build_all(params), the order in which every node group
 # of the parameter document is built.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# layered_groups.py, groups.py, runtime.py, then a main. Functions only.
+# A module of the gloffuse_blender package. Functions only.
 #
 #   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
 #                                                     params.py's resolve_params)
 # ---------------------------------------------------------------------------
+
 
 def build_all(params):
     """Build (or rebuild in place) every group of the resolved parameters
@@ -1860,16 +1856,46 @@ def build_all(params):
         built.append((spec, trees))
     return built
 
+# ======== gloffuse part: meshes.py ========
+# ---------------------------------------------------------------------------
+# gloffuse meshes.py: the smooth UV-sphere mesh the furnace, the previews and
+# the tests' material scene render.
+#
+# A module of the gloffuse_blender package. Functions only; the version
+# differences of building a sphere go through compat.py.
+#
+#   sphere_mesh(name, radius, segments, rings, cut_below=None) -> mesh
+# ---------------------------------------------------------------------------
+
+
+
+def sphere_mesh(name, radius, segments, rings, cut_below=None):
+    """A new smooth-shaded UV sphere mesh `name` around the origin, with one
+    empty material slot; with `cut_below`, the vertices below that height are
+    dropped (and the faces they belong to)."""
+    mesh = bpy.data.meshes.new(name)
+    bm = bmesh.new()
+    compat_uv_sphere(bm, radius, segments, rings)
+    if cut_below is not None:
+        bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.z < cut_below], context="VERTS")
+    bm.to_mesh(mesh)
+    bm.free()
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    compat_disable_auto_smooth(mesh)
+    mesh.materials.append(None)
+    mesh.update()
+    return mesh
+
 # ======== gloffuse part: runtime.py ========
 # ---------------------------------------------------------------------------
-# gloffuse runtime.py: helpers for the main scripts (generate_main.py,
-# furnace_main.py): the script's own arguments, opening and saving .blend
+# gloffuse runtime.py: helpers for the jobs' mains (generate.py,
+# furnace_job.py): the script's own arguments, opening and saving .blend
 # files, the result line, and error handling that never quits an interactive
 # Blender.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and classes only.
+# A module of the gloffuse_blender package; it imports none of the others.
+# Functions and classes only.
 #
 #   script_args(argv=None) -> the arguments meant for the script
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
@@ -1878,12 +1904,10 @@ def build_all(params):
 #   run_main(main) -> runs main with the error handling described there
 # ---------------------------------------------------------------------------
 import argparse
-import json
 import os
 import sys
 import traceback
 
-import bpy
 
 def running_in_blender_binary():
     """True inside the blender executable (its Text Editor or --python),
@@ -1998,15 +2022,11 @@ def render_result_image():
 # preview of that group and of the helper groups it uses. Everything made for
 # the renders is removed afterwards: the saved file holds only the groups.
 #
-# A part of the generate script: the binary concatenates the header, the
-# library parts (compat.py ... runtime.py), previews.py, then generate_main.py.
-# Functions and constants only.
+# A module of the gloffuse_blender package, used by the generate job
+# (generate.py). Functions and constants only.
 # ---------------------------------------------------------------------------
-import math
-import os
 
-import bpy
-import bmesh
+
 
 PREVIEW_SIZE = 128
 PREVIEW_SAMPLES = 64
@@ -2016,7 +2036,7 @@ PREVIEW_ROUGHNESS = 0.35
 
 def _studio_world():
     world = bpy.data.worlds.new("gloffuse preview world")
-    tree = compat_node_tree(world)  # noqa: F821 -- compat.py
+    tree = compat_node_tree(world)
     tree.nodes.clear()
     coords = tree.nodes.new("ShaderNodeTexCoord")
     split = tree.nodes.new("ShaderNodeSeparateXYZ")
@@ -2043,13 +2063,9 @@ def _preview_scene(made):
     render.resolution_percentage = 100
     scene.cycles.samples = PREVIEW_SAMPLES
     scene.cycles.device = "CPU"
-    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
-    compat_disable_post_processing(render)  # noqa: F821 -- compat.py
-    settings = render.image_settings
-    if hasattr(settings, "media_type"):  # 5.0: media_type before file_format
-        settings.media_type = "IMAGE"
-    settings.file_format = "PNG"
-    settings.color_mode = "RGBA"
+    compat_disable_denoising(scene)
+    compat_disable_post_processing(render)
+    compat_png_settings(render.image_settings)
     render.film_transparent = True  # the Asset Browser shows the sphere alone
     scene.world = _studio_world()
     made.append(scene.world)
@@ -2062,15 +2078,7 @@ def _preview_scene(made):
     scene.collection.objects.link(camera)
     scene.camera = camera
     made.extend([camera, camera_data])
-    mesh = bpy.data.meshes.new("gloffuse preview sphere")
-    bm = bmesh.new()
-    compat_uv_sphere(bm, 1.0, 64, 32)  # noqa: F821 -- compat.py
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = True
-    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
-    mesh.materials.append(None)
+    mesh = sphere_mesh("gloffuse preview sphere", 1.0, 64, 32)
     sphere = bpy.data.objects.new("gloffuse preview sphere", mesh)
     scene.collection.objects.link(sphere)
     made.extend([sphere, mesh])
@@ -2080,7 +2088,7 @@ def _preview_scene(made):
 def _render_group(scene, mesh, tree, path, made):
     material = bpy.data.materials.new("gloffuse preview " + tree.name)
     made.append(material)
-    node_tree = compat_node_tree(material)  # noqa: F821 -- compat.py
+    node_tree = compat_node_tree(material)
     node_tree.nodes.clear()
     group = node_tree.nodes.new("ShaderNodeGroup")
     group.node_tree = tree
@@ -2092,7 +2100,7 @@ def _render_group(scene, mesh, tree, path, made):
     mesh.materials[0] = material
     with bpy.context.temp_override(scene=scene):
         bpy.ops.render.render(write_still=False)
-        render_result_image().save_render(filepath=path)  # noqa: F821 -- runtime.py
+        render_result_image().save_render(filepath=path)
 
 
 def _set_preview(tree, path):
@@ -2141,7 +2149,7 @@ def render_previews(built, directory):
                 bpy.data.images.remove(image)
 
 
-# ======== gloffuse part: generate_main.py ========
+# ======== gloffuse part: generate.py ========
 # ---------------------------------------------------------------------------
 # gloffuse generate: add or update the node groups in a Blender file.
 #
@@ -2151,51 +2159,57 @@ def render_previews(built, directory):
 #   python3 THIS.py [--open IN.blend] [--save OUT.blend]      (with the bpy module)
 #
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
-# Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# layered_groups.py, groups.py and runtime.py, and previews.py.
+# The job module of the generate script: the gloffuse binary bundles it with
+# the modules it imports, after the header that defines GLOFFUSE_PARAMS (the
+# parameter document as a JSON string), and ends the script with
+# main(GLOFFUSE_PARAMS).
 # ---------------------------------------------------------------------------
-import sys  # also imported by runtime.py; repeated so this file reads on its own
 import tempfile
 
-import bpy
+
 
 
 def parse_generate_args(argv=None):
-    parser = ScriptArgumentParser(  # noqa: F821 -- runtime.py
+    parser = ScriptArgumentParser(
         prog="gloffuse-generate",
         description="Add or update gloffuse's brightness-correction node groups.")
     parser.add_argument("--open", metavar="IN.blend",
                         help="open this .blend file first (default: the file already open)")
     parser.add_argument("--save", metavar="OUT.blend",
                         help="save the result as this .blend file (default: do not save)")
-    return parse_script_args(parser, argv)  # noqa: F821 -- runtime.py
+    return parse_script_args(parser, argv)
 
 
-def generate_main():
+def generate_main(document_text):
     options = parse_generate_args()
-    params = load_params(GLOFFUSE_PARAMS)  # noqa: F821 -- header; params.py
+    params = load_params(document_text)
     if options.open:
-        open_blend(options.open)  # noqa: F821 -- runtime.py
+        open_blend(options.open)
     elif options.save and bpy.app.background:
         # A new library file holds the groups and nothing else: not the startup
         # file's cube, camera and light.
         bpy.ops.wm.read_factory_settings(use_empty=True)
-    built = build_all(params)  # noqa: F821 -- groups.py
+    built = build_all(params)
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
-            render_previews(built, directory)  # noqa: F821 -- previews.py
-    saved = save_blend(options.save) if options.save else None  # noqa: F821 -- runtime.py
+            render_previews(built, directory)
+    saved = save_blend(options.save) if options.save else None
     names = []
     for _spec, trees in built:
         names.extend(tree.name for tree in trees)
-    print(result_line({  # noqa: F821 -- runtime.py
-        "blender_version": blender_version_string(),  # noqa: F821 -- compat.py
+    print(result_line({
+        "blender_version": blender_version_string(),
         "groups": names,
         "saved": saved,
     }))
     sys.stdout.flush()
 
 
+def main(document_text):
+    """The generate job on the parameter document `document_text` (JSON), with
+    run_main's error handling: traceback, and exit 1 headless."""
+    run_main(lambda: generate_main(document_text))
+
+# ======== gloffuse: run the job on the parameter document ========
 if __name__ == "__main__":
-    run_main(generate_main)  # noqa: F821 -- runtime.py: traceback, exit 1 headless
+    main(GLOFFUSE_PARAMS)

@@ -7,51 +7,67 @@
 #   python3 THIS.py [--open IN.blend] [--save OUT.blend]      (with the bpy module)
 #
 # Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
-# Needs GLOFFUSE_PARAMS (header) and, above this file, the library parts compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# layered_groups.py, groups.py and runtime.py, and previews.py.
+# The job module of the generate script: the gloffuse binary bundles it with
+# the modules it imports, after the header that defines GLOFFUSE_PARAMS (the
+# parameter document as a JSON string), and ends the script with
+# main(GLOFFUSE_PARAMS).
 # ---------------------------------------------------------------------------
-import sys  # also imported by runtime.py; repeated so this file reads on its own
+import sys
 import tempfile
 
 import bpy
 
+from .compat import blender_version_string
+from .groups import build_all
+from .params import load_params
+from .previews import render_previews
+from .runtime import (
+    ScriptArgumentParser,
+    open_blend,
+    parse_script_args,
+    result_line,
+    run_main,
+    save_blend,
+)
+
 
 def parse_generate_args(argv=None):
-    parser = ScriptArgumentParser(  # noqa: F821 -- runtime.py
+    parser = ScriptArgumentParser(
         prog="gloffuse-generate",
         description="Add or update gloffuse's brightness-correction node groups.")
     parser.add_argument("--open", metavar="IN.blend",
                         help="open this .blend file first (default: the file already open)")
     parser.add_argument("--save", metavar="OUT.blend",
                         help="save the result as this .blend file (default: do not save)")
-    return parse_script_args(parser, argv)  # noqa: F821 -- runtime.py
+    return parse_script_args(parser, argv)
 
 
-def generate_main():
+def generate_main(document_text):
     options = parse_generate_args()
-    params = load_params(GLOFFUSE_PARAMS)  # noqa: F821 -- header; params.py
+    params = load_params(document_text)
     if options.open:
-        open_blend(options.open)  # noqa: F821 -- runtime.py
+        open_blend(options.open)
     elif options.save and bpy.app.background:
         # A new library file holds the groups and nothing else: not the startup
         # file's cube, camera and light.
         bpy.ops.wm.read_factory_settings(use_empty=True)
-    built = build_all(params)  # noqa: F821 -- groups.py
+    built = build_all(params)
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
-            render_previews(built, directory)  # noqa: F821 -- previews.py
-    saved = save_blend(options.save) if options.save else None  # noqa: F821 -- runtime.py
+            render_previews(built, directory)
+    saved = save_blend(options.save) if options.save else None
     names = []
     for _spec, trees in built:
         names.extend(tree.name for tree in trees)
-    print(result_line({  # noqa: F821 -- runtime.py
-        "blender_version": blender_version_string(),  # noqa: F821 -- compat.py
+    print(result_line({
+        "blender_version": blender_version_string(),
         "groups": names,
         "saved": saved,
     }))
     sys.stdout.flush()
 
 
-if __name__ == "__main__":
-    run_main(generate_main)  # noqa: F821 -- runtime.py: traceback, exit 1 headless
+def main(document_text):
+    """The generate job on the parameter document `document_text` (JSON), with
+    run_main's error handling: traceback, and exit 1 headless."""
+    run_main(lambda: generate_main(document_text))

@@ -4,12 +4,25 @@
 # reusing a group in place, its sockets, Math nodes, the clamped roughness,
 # frames and descriptions.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only; every version
-# difference it meets goes through compat.py.
+# A module of the gloffuse_blender package. Functions and constants only;
+# every version difference it meets goes through compat.py.
 # ---------------------------------------------------------------------------
 import bpy
+
+from .compat import (
+    blender_version_string,
+    clear_interface,
+    existing_signature_subtype,
+    interface_has_panels,
+    interface_sockets,
+    new_socket,
+    set_parent,
+    set_socket_description,
+    set_socket_hide_value,
+    set_socket_subtype,
+    signature_subtype,
+    socket_type_of,
+)
 
 # Layout of the generated nodes (Blender node-editor units).
 NODE_WIDTH = 180.0

@@ -14,11 +14,27 @@
 # input of the same name. EEVEE raises nothing: its group passes the normal
 # on and clamps the view cosine to [0, 1], as EEVEE reads its table.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# layered_groups.py, groups.py, runtime.py, then a main. Functions and constants only.
+# A module of the gloffuse_blender package. Functions and constants only.
 # ---------------------------------------------------------------------------
-import bpy
+from .compat import (
+    blender_version_string,
+    has_bump_map_correction,
+    mark_asset,
+    set_parent,
+    set_tree_description,
+    valid_reflection_rule,
+)
+from .nodes import (
+    COLUMN_STEP,
+    FRAME_INSET,
+    ROW_STEP,
+    Chain,
+    asset_fields,
+    ensure_interface,
+    new_frame,
+    reuse_or_create_group,
+    short_label,
+)
 
 NORMAL_INPUT = {
     "in_out": "INPUT", "name": "Normal", "type": "NodeSocketVector", "hide_value": True,

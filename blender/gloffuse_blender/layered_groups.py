@@ -16,9 +16,33 @@
 # slices around its IOR and mixes them linearly in z. E comes from the view groups' E(mu, r) image, mu
 # from the shading-normal group (normal_group.py).
 #
-# One part of the script the gloffuse binary concatenates, after
-# view_groups.py (whose albedo_lookup, grid_cell, read_cell and bilinear it uses). Functions and constants only.
+# A module of the gloffuse_blender package; it uses view_groups.py's
+# albedo_lookup, grid_cell, read_cell and bilinear. Functions and constants only.
 # ---------------------------------------------------------------------------
+from .compat import mark_asset, set_tree_description
+from .nodes import (
+    COLUMN_STEP,
+    FRAME_INSET,
+    Chain,
+    asset_fields,
+    clamped_roughness,
+    description_text,
+    ensure_interface,
+    new_frame,
+    reuse_or_create_group,
+)
+from .normal_group import NORMAL_INPUT, bump_map_correction_inputs
+from .params import finite_list
+from .view_groups import (
+    albedo_lookup,
+    bilinear,
+    corner_cells,
+    glossy_plus_diffuse,
+    grid_cell,
+    packed_float_image,
+    read_cell,
+    view_cosine,
+)
 
 # An index of 1 is no coat at all; the table's last slice (coat_table.ior_max) is the top.
 LAYERED_IOR_MIN = 1.0

@@ -9,21 +9,32 @@
 # because the film is transparent). The "furnace" section of the parameter
 # document says what to render (furnace_params checks it).
 #
-# A part of the scripts that render: the binary concatenates the header,
-# compat.py, params.py, nodes.py, roughness_groups.py, normal_group.py,
-# view_groups.py, layered_groups.py, groups.py, runtime.py, furnace.py, then furnace_main.py.
-# Functions and constants only; every Blender version difference in the scene
-# goes through compat.py's compat_* functions.
+# A module of the gloffuse_blender package, used by the furnace job
+# (furnace_job.py) and the tests' material scene. Functions and constants only;
+# every Blender version difference in the scene goes through compat.py's
+# compat_* functions.
 # ---------------------------------------------------------------------------
 import argparse
-import json
 import math
 import os
-import sys
 import time
 
 import bpy
-import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
+
+from .compat import (
+    compat_camera_rays_only,
+    compat_disable_denoising,
+    compat_disable_post_processing,
+    compat_disable_time_limit,
+    compat_eevee_engine,
+    compat_eevee_furnace,
+    compat_exr_settings,
+    compat_node_tree,
+    compat_principled_dielectric,
+    glossy_node,
+)
+from .meshes import sphere_mesh
+from .runtime import render_result_image
 
 FURNACE_PLAIN_DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY", "MULTI_GGX")
 FURNACE_ENGINES = ("cycles", "eevee")
@@ -152,7 +163,7 @@ def furnace_grid(furnace):
 
 def furnace_world():
     world = bpy.data.worlds.new("Gloffuse furnace world")
-    tree = compat_node_tree(world)  # noqa: F821 -- compat.py
+    tree = compat_node_tree(world)
     tree.nodes.clear()
     background = tree.nodes.new("ShaderNodeBackground")
     background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
@@ -166,9 +177,6 @@ def furnace_world():
 def furnace_sphere_mesh(radius):
     """One smooth-shaded UV dome shared by every sphere object; its single
     material slot is linked per object."""
-    mesh = bpy.data.meshes.new("Gloffuse furnace sphere")
-    bm = bmesh.new()
-    compat_uv_sphere(bm, radius, FURNACE_SPHERE_SEGMENTS, FURNACE_SPHERE_RINGS)  # noqa: F821
     # The camera looks down -Z and no other ray sees a sphere, so only the
     # upper half is ever hit: drop the rest (render time grows with the
     # triangle count: Cycles syncs a separate copy of the mesh for every object
@@ -176,15 +184,8 @@ def furnace_sphere_mesh(radius):
     # One ring below the equator stays so that the equator's smooth normals
     # stay horizontal.
     below = -radius * math.sin(math.pi / FURNACE_SPHERE_RINGS) * 1.001
-    bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.z < below], context="VERTS")
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = True
-    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
-    mesh.materials.append(None)
-    mesh.update()
-    return mesh
+    return sphere_mesh("Gloffuse furnace sphere", radius, FURNACE_SPHERE_SEGMENTS,
+                       FURNACE_SPHERE_RINGS, cut_below=below)
 
 
 def furnace_group_output(node):
@@ -218,7 +219,7 @@ def furnace_mix_shader(tree, sphere, color):
     fresnel.inputs["IOR"].default_value = sphere["ior"]
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = tuple(color) + (1.0,)
-    glossy = glossy_node(nodes, sphere["distribution"])  # noqa: F821 -- compat.py
+    glossy = glossy_node(nodes, sphere["distribution"])
     glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     glossy.inputs["Roughness"].default_value = sphere["roughness"]
     mix = nodes.new("ShaderNodeMixShader")
@@ -234,7 +235,7 @@ def furnace_material(index, sphere, color):
     Principled BSDF at its defaults (dielectric, IOR as given)."""
     material = bpy.data.materials.new("Furnace %03d %s r=%g"
                                       % (index, furnace_label(sphere), sphere["roughness"]))
-    tree = compat_node_tree(material)  # noqa: F821 -- compat.py
+    tree = compat_node_tree(material)
     tree.nodes.clear()
     output = tree.nodes.new("ShaderNodeOutputMaterial")
     output.target = "ALL"
@@ -243,7 +244,7 @@ def furnace_material(index, sphere, color):
         return material
     if sphere["shader"] == "principled":
         node = tree.nodes.new("ShaderNodeBsdfPrincipled")
-        compat_principled_dielectric(node, sphere["ior"])  # noqa: F821 -- compat.py
+        compat_principled_dielectric(node, sphere["ior"])
         shader_output = node.outputs["BSDF"]
     elif sphere["shader"] == "diffuse":
         node = tree.nodes.new("ShaderNodeBsdfDiffuse")
@@ -295,15 +296,15 @@ def furnace_render_settings(scene, furnace, columns, rows):
     render.pixel_aspect_y = 1.0
     render.use_border = False
     render.film_transparent = True
-    compat_disable_post_processing(render)  # noqa: F821 -- compat.py
+    compat_disable_post_processing(render)
     if furnace["threads"] > 0:
         render.threads_mode = "FIXED"
         render.threads = furnace["threads"]
     else:
         render.threads_mode = "AUTO"
     if furnace["engine"] == "eevee":
-        render.engine = compat_eevee_engine()  # noqa: F821 -- compat.py
-        compat_eevee_furnace(scene, scene.world, furnace["samples"])  # noqa: F821
+        render.engine = compat_eevee_engine()
+        compat_eevee_furnace(scene, scene.world, furnace["samples"])
     else:
         render.engine = "CYCLES"
         furnace_cycles_settings(scene.cycles, scene, furnace)
@@ -315,7 +316,7 @@ def furnace_render_settings(scene, furnace, columns, rows):
     view.exposure = 0.0
     view.gamma = 1.0
     view.use_curve_mapping = False
-    compat_exr_settings(render.image_settings)  # noqa: F821 -- compat.py
+    compat_exr_settings(render.image_settings)
 
 
 def furnace_cycles_settings(cycles, scene, furnace):
@@ -326,11 +327,11 @@ def furnace_cycles_settings(cycles, scene, furnace):
     cycles.seed = furnace["seed"]
     cycles.use_animated_seed = False
     cycles.use_adaptive_sampling = False
-    compat_disable_time_limit(cycles)  # noqa: F821 -- compat.py
+    compat_disable_time_limit(cycles)
     # Clamping would bias the estimate; 0 disables it.
     cycles.sample_clamp_direct = 0.0
     cycles.sample_clamp_indirect = 0.0
-    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
+    compat_disable_denoising(scene)
 
 
 def furnace_scene(furnace):
@@ -353,7 +354,7 @@ def furnace_scene(furnace):
         slot = obj.material_slots[0]
         slot.link = "OBJECT"
         slot.material = furnace_material(index, sphere, furnace["color"])
-        compat_camera_rays_only(obj)  # noqa: F821 -- compat.py
+        compat_camera_rays_only(obj)
     return scene
 
 

@@ -16,12 +16,30 @@
 # as Kulla and Conty (and Blender's Multiscatter GGX) do:
 # Fms = C E_avg / (1 - C (1 - E_avg)), colour C (1 + Fms (1 - E) / E).
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only; the socket lists
+# A module of the gloffuse_blender package. Functions and constants only; the socket lists
 # below extend roughness_groups.py's.
 # ---------------------------------------------------------------------------
 import bpy
+
+from .compat import glossy_node, mark_asset, multiply_color_node, set_parent, set_tree_description
+from .nodes import (
+    COLUMN_STEP,
+    FRAME_INSET,
+    NODE_WIDTH,
+    ROW_STEP,
+    Chain,
+    asset_fields,
+    clamped_roughness,
+    description_text,
+    ensure_interface,
+    math_node,
+    new_frame,
+    reuse_or_create_group,
+    short_label,
+)
+from .normal_group import NORMAL_INPUT, bump_map_correction_inputs, is_eevee, normal_group_node
+from .params import finite_list
+from .roughness_groups import CORRECTION_SOCKETS, SHADER_SOCKETS, build_glossy_group
 
 def view_correction_sockets(spec):
     """Roughness, Color, Normal [, Bump Map Correction] -> Color, Gain."""

@@ -3,10 +3,9 @@
 # Blender versions gloffuse supports (3.4 .. 5.0; the binary, its Text Editor,
 # or the `bpy` module) lives here and nowhere else.
 #
-# One part of the script the gloffuse binary concatenates: header
-# (GLOFFUSE_PARAMS), compat.py, params.py, nodes.py, roughness_groups.py,
-# normal_group.py, view_groups.py, layered_groups.py, groups.py, runtime.py, then a main (generate_main.py or
-# furnace_main.py). It defines functions and constants only.
+# A module of the gloffuse_blender package; it imports none of the others.
+# Functions and constants only. Every Blender version check of the package
+# (bpy.app.version, or a feature test standing for one) is here.
 # ---------------------------------------------------------------------------
 import bpy
 import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
@@ -228,7 +227,7 @@ def set_parent(node, frame):
     node.parent = frame
 
 
-# --- furnace scene (used by furnace_main.py) -----------------------------------
+# --- scenes (furnace.py, meshes.py, previews.py) --------------------------------
 
 def compat_node_tree(id_block):
     """The node tree of a world or material, creating it where needed.
@@ -285,6 +284,14 @@ def compat_exr_settings(settings):
         settings.use_preview = False
     if hasattr(settings, "color_management"):
         settings.color_management = "FOLLOW_SCENE"
+
+
+def compat_png_settings(settings):
+    """PNG, RGBA (the previews). 5.0 needs media_type before file_format."""
+    if hasattr(settings, "media_type"):
+        settings.media_type = "IMAGE"
+    settings.file_format = "PNG"
+    settings.color_mode = "RGBA"
 
 
 def compat_uv_sphere(bm, radius, segments, rings):

@@ -2,13 +2,17 @@
 # gloffuse groups.py: build_all(params), the order in which every node group
 # of the parameter document is built.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py,
-# layered_groups.py, groups.py, runtime.py, then a main. Functions only.
+# A module of the gloffuse_blender package. Functions only.
 #
 #   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
 #                                                     params.py's resolve_params)
 # ---------------------------------------------------------------------------
+from .layered_groups import build_layered_group
+from .normal_group import build_normal_group
+from .params import validate_params
+from .roughness_groups import build_correction_group, build_shader_group
+from .view_groups import build_multiscatter_group, build_view_correction_group, build_view_shader_group
+
 
 def build_all(params):
     """Build (or rebuild in place) every group of the resolved parameters

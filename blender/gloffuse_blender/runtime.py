@@ -1,12 +1,11 @@
 # ---------------------------------------------------------------------------
-# gloffuse runtime.py: helpers for the main scripts (generate_main.py,
-# furnace_main.py): the script's own arguments, opening and saving .blend
+# gloffuse runtime.py: helpers for the jobs' mains (generate.py,
+# furnace_job.py): the script's own arguments, opening and saving .blend
 # files, the result line, and error handling that never quits an interactive
 # Blender.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and classes only.
+# A module of the gloffuse_blender package; it imports none of the others.
+# Functions and classes only.
 #
 #   script_args(argv=None) -> the arguments meant for the script
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)

@@ -2,10 +2,8 @@
 # gloffuse params.py: checks the parameter document (GLOFFUSE_PARAMS) before
 # anything is built, and says what is wrong with it.
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only; uses
-# max_name_bytes() from compat.py.
+# A module of the gloffuse_blender package. Functions and constants only; uses
+# max_name_bytes() and masking_family() from compat.py.
 #
 #   load_params(text) -> dict          parse the parameter JSON and resolve it
 #   resolve_params(document) -> params the document as the builders read it:
@@ -15,6 +13,8 @@
 # ---------------------------------------------------------------------------
 import json
 import math
+
+from .compat import masking_family, max_name_bytes
 
 DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
 CURVE_VARIABLES = ("roughness", "alpha")

@@ -3,13 +3,31 @@
 # group (Roughness, Color -> Color, Gain with Gain = 100 / f(x), f the fitted
 # curve) and the shader group (a Glossy BSDF whose colour goes through it).
 #
-# One part of the script the gloffuse binary concatenates: header, compat.py,
-# params.py, nodes.py, roughness_groups.py, normal_group.py, view_groups.py, layered_groups.py, groups.py,
-# runtime.py, then a main. Functions and constants only.
+# A module of the gloffuse_blender package. Functions and constants only.
 #
 #   build_correction_group(spec, params) -> correction tree
 #   build_shader_group(spec, params, correction_tree) -> shader tree
 # ---------------------------------------------------------------------------
+from .compat import glossy_node, mark_asset, multiply_color_node, set_parent, set_tree_description
+from .nodes import (
+    COLUMN_STEP,
+    FRAME_INSET,
+    NODE_WIDTH,
+    ROW_STEP,
+    Chain,
+    asset_fields,
+    clamped_roughness,
+    curve_text,
+    description_text,
+    ensure_interface,
+    fmt,
+    frame_label,
+    math_node,
+    new_frame,
+    reuse_or_create_group,
+    short_label,
+    trim_coefficients,
+)
 
 CORRECTION_SOCKETS = [
     {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",

@@ -5,15 +5,22 @@
 # preview of that group and of the helper groups it uses. Everything made for
 # the renders is removed afterwards: the saved file holds only the groups.
 #
-# A part of the generate script: the binary concatenates the header, the
-# library parts (compat.py ... runtime.py), previews.py, then generate_main.py.
-# Functions and constants only.
+# A module of the gloffuse_blender package, used by the generate job
+# (generate.py). Functions and constants only.
 # ---------------------------------------------------------------------------
 import math
 import os
 
 import bpy
-import bmesh
+
+from .compat import (
+    compat_disable_denoising,
+    compat_disable_post_processing,
+    compat_node_tree,
+    compat_png_settings,
+)
+from .meshes import sphere_mesh
+from .runtime import render_result_image
 
 PREVIEW_SIZE = 128
 PREVIEW_SAMPLES = 64
@@ -23,7 +30,7 @@ PREVIEW_ROUGHNESS = 0.35
 
 def _studio_world():
     world = bpy.data.worlds.new("gloffuse preview world")
-    tree = compat_node_tree(world)  # noqa: F821 -- compat.py
+    tree = compat_node_tree(world)
     tree.nodes.clear()
     coords = tree.nodes.new("ShaderNodeTexCoord")
     split = tree.nodes.new("ShaderNodeSeparateXYZ")
@@ -50,13 +57,9 @@ def _preview_scene(made):
     render.resolution_percentage = 100
     scene.cycles.samples = PREVIEW_SAMPLES
     scene.cycles.device = "CPU"
-    compat_disable_denoising(scene)  # noqa: F821 -- compat.py
-    compat_disable_post_processing(render)  # noqa: F821 -- compat.py
-    settings = render.image_settings
-    if hasattr(settings, "media_type"):  # 5.0: media_type before file_format
-        settings.media_type = "IMAGE"
-    settings.file_format = "PNG"
-    settings.color_mode = "RGBA"
+    compat_disable_denoising(scene)
+    compat_disable_post_processing(render)
+    compat_png_settings(render.image_settings)
     render.film_transparent = True  # the Asset Browser shows the sphere alone
     scene.world = _studio_world()
     made.append(scene.world)
@@ -69,15 +72,7 @@ def _preview_scene(made):
     scene.collection.objects.link(camera)
     scene.camera = camera
     made.extend([camera, camera_data])
-    mesh = bpy.data.meshes.new("gloffuse preview sphere")
-    bm = bmesh.new()
-    compat_uv_sphere(bm, 1.0, 64, 32)  # noqa: F821 -- compat.py
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = True
-    compat_disable_auto_smooth(mesh)  # noqa: F821 -- compat.py
-    mesh.materials.append(None)
+    mesh = sphere_mesh("gloffuse preview sphere", 1.0, 64, 32)
     sphere = bpy.data.objects.new("gloffuse preview sphere", mesh)
     scene.collection.objects.link(sphere)
     made.extend([sphere, mesh])
@@ -87,7 +82,7 @@ def _preview_scene(made):
 def _render_group(scene, mesh, tree, path, made):
     material = bpy.data.materials.new("gloffuse preview " + tree.name)
     made.append(material)
-    node_tree = compat_node_tree(material)  # noqa: F821 -- compat.py
+    node_tree = compat_node_tree(material)
     node_tree.nodes.clear()
     group = node_tree.nodes.new("ShaderNodeGroup")
     group.node_tree = tree
@@ -99,7 +94,7 @@ def _render_group(scene, mesh, tree, path, made):
     mesh.materials[0] = material
     with bpy.context.temp_override(scene=scene):
         bpy.ops.render.render(write_still=False)
-        render_result_image().save_render(filepath=path)  # noqa: F821 -- runtime.py
+        render_result_image().save_render(filepath=path)
 
 
 def _set_preview(tree, path):
