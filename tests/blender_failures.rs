@@ -24,10 +24,10 @@ use exr::prelude::{Compression, Encoding, Image, SpecificChannels, Vec2, Writabl
 use tempfile::TempDir;
 
 /// The stand-in `blender`. The version probe gloffuse runs is
-/// `blender -b --factory-startup -noaudio --version` (src/blender/discover.rs): it must exit
+/// `blender -b --factory-startup -noaudio --version` (crates/gloffuse/src/blender/discover.rs): it must exit
 /// 0 with a line starting `Blender X.Y`. A run is
 /// `blender -b --factory-startup -noaudio --python-exit-code 1 --python SCRIPT -- ARGS`
-/// (src/blender/run.rs); the stand-in finds SCRIPT (the run directory is its folder) and
+/// (crates/gloffuse/src/blender/run.rs); the stand-in finds SCRIPT (the run directory is its folder) and
 /// generate's `--save OUT`, then does `body`.
 fn stand_in(dir: &Path, version_line: &str, body: &str) -> PathBuf {
     fs::create_dir_all(dir).unwrap();

@@ -1,4 +1,4 @@
-//! Outputs the user points at are written without being destroyed (`src/output.rs`): a
+//! Outputs the user points at are written without being destroyed (`crates/gloffuse/src/output.rs`): a
 //! symbolic link is written through to its target and stays a link; a FIFO, a character
 //! device or `/dev/stdout` is streamed to; `-` is standard output (and the summary moves to
 //! stderr); a regular file is replaced atomically; and no output makes a missing folder.

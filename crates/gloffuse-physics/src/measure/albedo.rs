@@ -52,7 +52,7 @@ impl Default for AlbedoIntegrator {
 }
 
 /// Gauss–Legendre nodes and weights on [0, 1].
-pub(crate) fn gauss_unit(n: usize) -> Vec<(f64, f64)> {
+pub fn gauss_unit(n: usize) -> Vec<(f64, f64)> {
     let n = NonZeroUsize::new(n.max(1)).expect("max(1) is non-zero");
     GaussLegendre::new(n)
         .as_node_weight_pairs()

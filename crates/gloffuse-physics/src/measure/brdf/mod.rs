@@ -195,7 +195,7 @@ impl Default for ModelParams {
 /// by [`Brdf::albedo`] on an [`ALBEDO_GRID`]² grid.
 ///
 /// ```
-/// use gloffuse::measure::brdf::{model_albedo, Model, ModelParams};
+/// use gloffuse_physics::measure::brdf::{model_albedo, Model, ModelParams};
 /// let p = ModelParams { rho: 0.5, ..ModelParams::default() };
 /// let e = model_albedo("Lambert".parse().unwrap(), &p, 0.3).unwrap();
 /// assert!((e - 0.5).abs() < 1e-12);

@@ -21,7 +21,7 @@ pub const ID: &str = "gloffuse";
 pub const LIBRARY_FOLDER: &str = "library";
 pub const LIBRARY_FILE: &str = "gloffuse.blend";
 
-const LICENSE: &str = include_str!("../../LICENSE");
+const LICENSE: &str = include_str!("../../../../LICENSE");
 
 /// The manifest. `blender_version_min` is the Blender that saved the library: an older one
 /// may not read the file (5.0's .blend format is new) or its node sockets.

@@ -28,7 +28,7 @@ pub const BACKGROUND: f32 = 0.18;
 /// Size of the brightness plot in pixels.
 pub const PLOT_SIZE: (u32, u32) = (900, 820);
 
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
 pub(super) const FAMILY: &str = "sans-serif";
 
 /// Label column and header of the contact sheet (sRGB).

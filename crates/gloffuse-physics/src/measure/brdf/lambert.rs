@@ -16,7 +16,7 @@ impl Lambert {
     /// ρ must be in [0, 1].
     ///
     /// ```
-    /// use gloffuse::measure::brdf::{Brdf, Lambert};
+    /// use gloffuse_physics::measure::brdf::{Brdf, Lambert};
     /// assert!((Lambert::new(0.5).unwrap().albedo(0.2, 4) - 0.5).abs() < 1e-12);
     /// assert!(Lambert::new(1.5).is_err());
     /// ```

@@ -20,22 +20,22 @@ pub const FORMAT_VERSION: u32 = 1;
 pub const PRESETS: [(&str, &str, &str); 4] = [
     (
         "seed",
-        include_str!("../../presets/seed.json"),
+        include_str!("../../../../presets/seed.json"),
         "the original hand-made two-point cubics (display-referred; kept for comparison)",
     ),
     (
         "blender-3",
-        include_str!("../../presets/blender-3.json"),
+        include_str!("../../../../presets/blender-3.json"),
         "linear-space fits to E_avg for Blender 3.0–3.4 (separable masking)",
     ),
     (
         "blender-4",
-        include_str!("../../presets/blender-4.json"),
+        include_str!("../../../../presets/blender-4.json"),
         "linear-space fits to E_avg for Blender 3.5 and later (height-correlated masking)",
     ),
     (
         "eevee",
-        include_str!("../../presets/eevee.json"),
+        include_str!("../../../../presets/eevee.json"),
         "linear-space fits to E_avg for EEVEE (every distribution renders as its split-sum GGX)",
     ),
 ];

@@ -24,67 +24,67 @@ pub const PACKAGE: &str = "gloffuse_blender";
 pub const MODULES: &[(&str, &str)] = &[
     (
         "__init__",
-        include_str!("../../blender/gloffuse_blender/__init__.py"),
+        include_str!("../../../../blender/gloffuse_blender/__init__.py"),
     ),
     (
         "addon",
-        include_str!("../../blender/gloffuse_blender/addon.py"),
+        include_str!("../../../../blender/gloffuse_blender/addon.py"),
     ),
     (
         "compat",
-        include_str!("../../blender/gloffuse_blender/compat.py"),
+        include_str!("../../../../blender/gloffuse_blender/compat.py"),
     ),
     (
         "furnace",
-        include_str!("../../blender/gloffuse_blender/furnace.py"),
+        include_str!("../../../../blender/gloffuse_blender/furnace.py"),
     ),
     (
         "furnace_job",
-        include_str!("../../blender/gloffuse_blender/furnace_job.py"),
+        include_str!("../../../../blender/gloffuse_blender/furnace_job.py"),
     ),
     (
         "generate",
-        include_str!("../../blender/gloffuse_blender/generate.py"),
+        include_str!("../../../../blender/gloffuse_blender/generate.py"),
     ),
     (
         "groups",
-        include_str!("../../blender/gloffuse_blender/groups.py"),
+        include_str!("../../../../blender/gloffuse_blender/groups.py"),
     ),
     (
         "layered_groups",
-        include_str!("../../blender/gloffuse_blender/layered_groups.py"),
+        include_str!("../../../../blender/gloffuse_blender/layered_groups.py"),
     ),
     (
         "meshes",
-        include_str!("../../blender/gloffuse_blender/meshes.py"),
+        include_str!("../../../../blender/gloffuse_blender/meshes.py"),
     ),
     (
         "nodes",
-        include_str!("../../blender/gloffuse_blender/nodes.py"),
+        include_str!("../../../../blender/gloffuse_blender/nodes.py"),
     ),
     (
         "normal_group",
-        include_str!("../../blender/gloffuse_blender/normal_group.py"),
+        include_str!("../../../../blender/gloffuse_blender/normal_group.py"),
     ),
     (
         "params",
-        include_str!("../../blender/gloffuse_blender/params.py"),
+        include_str!("../../../../blender/gloffuse_blender/params.py"),
     ),
     (
         "previews",
-        include_str!("../../blender/gloffuse_blender/previews.py"),
+        include_str!("../../../../blender/gloffuse_blender/previews.py"),
     ),
     (
         "roughness_groups",
-        include_str!("../../blender/gloffuse_blender/roughness_groups.py"),
+        include_str!("../../../../blender/gloffuse_blender/roughness_groups.py"),
     ),
     (
         "runtime",
-        include_str!("../../blender/gloffuse_blender/runtime.py"),
+        include_str!("../../../../blender/gloffuse_blender/runtime.py"),
     ),
     (
         "view_groups",
-        include_str!("../../blender/gloffuse_blender/view_groups.py"),
+        include_str!("../../../../blender/gloffuse_blender/view_groups.py"),
     ),
 ];
 
@@ -467,7 +467,10 @@ mod tests {
 
     #[test]
     fn the_table_holds_every_module_of_the_package() {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/blender/gloffuse_blender");
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../blender/gloffuse_blender"
+        );
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().into_string().unwrap())

@@ -1,0 +1,24 @@
+//! gloffuse: measure, fit and correct the energy loss of Blender's glossy BSDFs.
+//!
+//! Data flows one way, and the module names say where: [`measure`] (the physics, from the
+//! `gloffuse-physics` crate) → [`fit`] (curves and the coefficients file) → [`generate`]
+//! (the node groups) → [`verify`] (furnace renders and the verdict) → [`report`] (renderers
+//! of the verdict). [`albedo`], [`lut`], [`refresh`] and [`bench`] are commands composed of
+//! those stages; [`blender`] runs Blender. The library returns data and never prints or
+//! parses flags: long work reports through [`progress::Progress`], and errors name their
+//! input by a typed [`Field`]. See `docs/ARCHITECTURE.md`.
+
+pub use gloffuse_physics::{error, measure, progress};
+
+pub mod albedo;
+pub mod bench;
+pub mod blender;
+pub mod fit;
+pub mod generate;
+pub mod lut;
+pub mod output;
+pub mod refresh;
+pub mod report;
+pub mod verify;
+
+pub use error::{Error, Field, Hint, Result};

@@ -1,0 +1,298 @@
+//! The structure docs/ARCHITECTURE.md describes, checked: which crate may depend on what,
+//! which stage may import which, that the library never names a command-line flag, and
+//! that a long function says why it is long.
+
+use std::collections::BTreeSet;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+const PHYSICS: &str = "crates/gloffuse-physics";
+const LIBRARY: &str = "crates/gloffuse";
+const CLI: &str = "src/cli";
+
+/// The library's stages in the order data flows; each may import only those before it.
+const STAGES: [&str; 5] = ["measure", "fit", "generate", "verify", "report"];
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for entry in fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files.extend(rust_files(&path));
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            files.push(path);
+        }
+    }
+    files.sort();
+    files
+}
+
+/// The names in a manifest's `[dependencies]` table.
+fn dependencies(manifest: &Path) -> BTreeSet<String> {
+    let text = fs::read_to_string(manifest).unwrap();
+    let mut names = BTreeSet::new();
+    let mut inside = false;
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with('[') {
+            inside = line == "[dependencies]";
+        } else if inside && !line.is_empty() && !line.starts_with('#') {
+            let name = line.split(['=', '.', ' ']).next().unwrap();
+            names.insert(name.trim().to_string());
+        }
+    }
+    names
+}
+
+#[test]
+fn the_physics_crate_has_no_blender_io_or_cli_dependencies() {
+    let deps = dependencies(&root().join(PHYSICS).join("Cargo.toml"));
+    let allowed = [
+        "gauss-quad",
+        "glam",
+        "nalgebra",
+        "rayon",
+        "serde",
+        "thiserror",
+    ];
+    for dep in &deps {
+        assert!(
+            allowed.contains(&dep.as_str()),
+            "{PHYSICS} depends on {dep}: the physics crate holds only numerics (allowed: {allowed:?})"
+        );
+    }
+    assert!(deps.contains("glam"), "the manifest was read: {deps:?}");
+}
+
+#[test]
+fn the_library_depends_on_no_cli_crate() {
+    let deps = dependencies(&root().join(LIBRARY).join("Cargo.toml"));
+    assert!(
+        deps.contains("gloffuse-physics"),
+        "the manifest was read: {deps:?}"
+    );
+    for cli_only in ["clap", "indicatif"] {
+        assert!(!deps.contains(cli_only), "{LIBRARY} depends on {cli_only}");
+    }
+}
+
+/// `crate::x` (and `gloffuse_physics::x`) module names a file's code (not its comments)
+/// refers to.
+fn imported_modules(text: &str) -> BTreeSet<String> {
+    let text: String = text.lines().map(|l| format!("{}\n", code_of(l))).collect();
+    let mut names = BTreeSet::new();
+    for prefix in ["crate::", "gloffuse_physics::"] {
+        for (i, _) in text.match_indices(prefix) {
+            let rest = &text[i + prefix.len()..];
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            if !name.is_empty() {
+                names.insert(name);
+            }
+        }
+    }
+    names
+}
+
+#[test]
+fn stages_import_only_the_stages_before_them() {
+    let src = root().join(LIBRARY).join("src");
+    let mut checked = 0;
+    for (i, stage) in STAGES.iter().enumerate() {
+        let dir = src.join(stage);
+        if !dir.is_dir() {
+            continue; // measure lives in the physics crate
+        }
+        for file in rust_files(&dir) {
+            let text = fs::read_to_string(&file).unwrap();
+            for module in imported_modules(&text) {
+                if let Some(j) = STAGES.iter().position(|s| *s == module) {
+                    assert!(
+                        j <= i,
+                        "{} ({stage}) imports {module}, a later stage",
+                        file.display()
+                    );
+                }
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 20, "only {checked} files checked");
+    // The infrastructure serves the stages and imports none of them but measure.
+    for infra in ["blender", "output.rs"] {
+        let path = src.join(infra);
+        let files = if path.is_dir() {
+            rust_files(&path)
+        } else {
+            vec![path]
+        };
+        for file in files {
+            let text = fs::read_to_string(&file).unwrap();
+            for module in imported_modules(&text) {
+                assert!(
+                    !STAGES[1..].contains(&module.as_str()),
+                    "{} (infrastructure) imports the stage {module}",
+                    file.display()
+                );
+            }
+        }
+    }
+}
+
+/// A line unless it is a `//` comment.
+fn code_of(line: &str) -> &str {
+    let trimmed = line.trim_start();
+    if trimmed.starts_with("//") {
+        return "";
+    }
+    line
+}
+
+/// The `--flag` words in a text.
+fn flags_in(text: &str) -> BTreeSet<String> {
+    let mut flags = BTreeSet::new();
+    for (i, _) in text.match_indices("--") {
+        let before = text[..i].chars().next_back();
+        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '-') {
+            continue;
+        }
+        let word: String = text[i + 2..]
+            .chars()
+            .take_while(|c| c.is_ascii_lowercase() || *c == '-')
+            .collect();
+        if word.len() > 1 && !word.ends_with('-') {
+            flags.insert(format!("--{word}"));
+        }
+    }
+    flags
+}
+
+#[test]
+fn only_the_cli_names_its_flags() {
+    let mut cli_flags = BTreeSet::new();
+    for file in rust_files(&root().join(CLI)) {
+        cli_flags.extend(flags_in(&fs::read_to_string(file).unwrap()));
+    }
+    for known in [
+        "--blender",
+        "--coefficients",
+        "--engine",
+        "--roughness",
+        "--timeout",
+    ] {
+        assert!(
+            cli_flags.contains(known),
+            "the CLI's flags were read: {known}"
+        );
+    }
+    // Blender's own flags and the generated script's arguments, which the library passes.
+    let passed_on = ["--python", "--save", "--open", "--factory-startup", "--version"];
+    let mut offenders = Vec::new();
+    for crate_dir in [PHYSICS, LIBRARY] {
+        for file in rust_files(&root().join(crate_dir).join("src")) {
+            let text = fs::read_to_string(&file).unwrap();
+            // Unit tests may name flags: they stand in for the CLI's mapping.
+            let code = text.split("#[cfg(test)]").next().unwrap();
+            for (n, line) in code.lines().enumerate() {
+                for flag in flags_in(code_of(line)) {
+                    if cli_flags.contains(&flag) && !passed_on.contains(&flag.as_str()) {
+                        offenders.push(format!("{}:{}: {flag}", file.display(), n + 1));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        offenders.is_empty(),
+        "the library names CLI flags (use a typed Field; the CLI maps it):\n{}",
+        offenders.join("\n")
+    );
+}
+
+/// Functions longer than `limit` lines with no `// Long on purpose:` comment in or just
+/// above them.
+fn unexplained_long_functions(file: &Path, limit: usize) -> Vec<String> {
+    let text = fs::read_to_string(file).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let trimmed = line.trim_start();
+        let indent = &line[..line.len() - trimmed.len()];
+        let is_fn = trimmed
+            .split_whitespace()
+            .take_while(|w| *w != "fn")
+            .all(|w| {
+                [
+                    "pub",
+                    "pub(crate)",
+                    "pub(super)",
+                    "const",
+                    "unsafe",
+                    "extern",
+                    "\"C\"",
+                ]
+                .contains(&w)
+            })
+            && trimmed.split_whitespace().any(|w| w == "fn");
+        if !is_fn || trimmed.ends_with(';') {
+            continue;
+        }
+        let Some(end) =
+            (i + 1..lines.len()).find(|&j| lines[j].starts_with(&format!("{indent}}}")))
+        else {
+            continue;
+        };
+        let length = end - i + 1;
+        let above = i.saturating_sub(1);
+        let explained = lines[above..=end]
+            .iter()
+            .any(|l| l.trim_start().starts_with("// Long on purpose:"));
+        if length > limit && !explained {
+            found.push(format!("{}:{} ({length} lines)", file.display(), i + 1));
+        }
+    }
+    found
+}
+
+#[test]
+fn a_long_function_says_why_it_is_long() {
+    let mut found = Vec::new();
+    let mut files = 0;
+    for dir in [PHYSICS, LIBRARY] {
+        for file in rust_files(&root().join(dir).join("src")) {
+            found.extend(unexplained_long_functions(&file, 80));
+            files += 1;
+        }
+    }
+    for file in rust_files(&root().join("src")) {
+        found.extend(unexplained_long_functions(&file, 80));
+        files += 1;
+    }
+    assert!(files > 50, "only {files} files read");
+    assert!(
+        found.is_empty(),
+        "functions over 80 lines without a `// Long on purpose:` reason:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_long_function_check_can_fail() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = "    let x = 1;\n".repeat(90);
+    let long = dir.path().join("long.rs");
+    fs::write(&long, format!("pub fn long() {{\n{body}}}\n")).unwrap();
+    assert_eq!(unexplained_long_functions(&long, 80).len(), 1);
+    fs::write(
+        &long,
+        format!("// Long on purpose: a kernel.\npub fn long() {{\n{body}}}\n"),
+    )
+    .unwrap();
+    assert!(unexplained_long_functions(&long, 80).is_empty());
+}
