@@ -293,140 +293,33 @@ pub enum Spec {
 impl Spec {
     /// Checks the numbers and the flag combinations; errors name the flag.
     pub fn from_options(args: &LutOptions) -> Result<Spec, Error> {
-        let (default_size, default_samples) = match args.kind {
-            Kind::SplitSum => (512, 2048),
-            Kind::KullaConty => (64, 4096),
-            Kind::Albedo | Kind::Coat => (64, 1),
-        };
-        let size = args.size.unwrap_or(default_size);
-        let samples = args.samples.unwrap_or(default_samples);
-        if size == 0 || size > MAX_SIZE {
-            return Err(Error::input(
-                Field::Size,
-                size,
-                format!("texels per side from 1 to {MAX_SIZE}"),
-            ));
-        }
-        if samples == 0 || samples > MAX_SAMPLES {
-            return Err(Error::input(
-                Field::Samples,
-                samples,
-                format!("samples per texel from 1 to {MAX_SAMPLES}"),
-            ));
-        }
-        if args.kind == Kind::Coat && size > coat::MAX_SIZE {
-            return Err(Error::input(
-                Field::Size,
-                size,
-                Hint::new(
-                    format!(
-                        "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
-                        coat::MAX_SIZE,
-                        crate::measure::coat::SLICES
-                    ),
-                    [Field::Kind],
-                ),
-            ));
-        }
-        let size = size as usize;
+        let (size, samples) = checked_counts(args)?;
+        let distribution = args.distribution.unwrap_or(Distribution::Ggx);
+        let blender_version = args.blender_version.unwrap_or(BlenderVersion::DEFAULT);
         match args.kind {
-            Kind::SplitSum => {
-                if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
-                    return Err(Error::input(
-                        Field::Distribution,
-                        d.key(),
-                        Hint::new(
-                            "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
-                            [Field::Kind],
-                        ),
-                    ));
-                }
-                if let Some(v) = args.blender_version {
-                    return Err(Error::input(
-                        Field::BlenderVersion,
-                        v,
-                        Hint::new(
-                            "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
-                            [Field::Kind, Field::GModel, Field::BlenderVersion],
-                        ),
-                    ));
-                }
-                let estimate = match args.method.unwrap_or(Method::Quadrature) {
-                    Method::Quadrature => {
-                        if let Some(n) = args.samples {
-                            return Err(Error::input(
-                                Field::Samples,
-                                n,
-                                Hint::new(
-                                    "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
-                                    [Field::Kind, Field::Method, Field::Samples, Field::Method],
-                                ),
-                            ));
-                        }
-                        split_sum::Estimate::Quadrature(split_sum::Rule::default())
-                    }
-                    Method::Classic => split_sum::Estimate::Classic { samples },
-                };
-                Ok(Spec::SplitSum {
+            Kind::SplitSum => split_sum_spec(args, size, samples),
+            Kind::KullaConty => {
+                reject_split_sum_flags(args)?;
+                Ok(Spec::KullaConty {
                     size,
-                    g_model: args.g_model.unwrap_or(GModel::Ue4),
-                    estimate,
+                    samples,
+                    distribution,
+                    blender_version,
                 })
             }
-            Kind::KullaConty | Kind::Albedo | Kind::Coat => {
-                let kind = args.kind.key();
-                if let Some(g) = args.g_model {
-                    return Err(Error::input(
-                        Field::GModel,
-                        g.key(),
-                        Hint::new(
-                            format!(
-                                "nothing with {{}} {kind} (its masking follows {{}}; {{}} applies to split-sum)"
-                            ),
-                            [Field::Kind, Field::BlenderVersion, Field::GModel],
-                        ),
-                    ));
-                }
-                if let Some(m) = args.method {
-                    return Err(Error::input(
-                        Field::Method,
-                        m.key(),
-                        Hint::new(
-                            format!("nothing with {{}} {kind} ({{}} applies to split-sum)"),
-                            [Field::Kind, Field::Method],
-                        ),
-                    ));
-                }
-                let distribution = args.distribution.unwrap_or(Distribution::Ggx);
-                let blender_version = args.blender_version.unwrap_or(BlenderVersion::DEFAULT);
-                if args.kind == Kind::KullaConty {
-                    return Ok(Spec::KullaConty {
-                        size,
-                        samples,
-                        distribution,
-                        blender_version,
-                    });
-                }
-                if let Some(n) = args.samples {
-                    return Err(Error::input(
-                        Field::Samples,
-                        n,
-                        Hint::new(
-                            format!(
-                                "nothing with {{}} {kind} (it is integrated by deterministic quadrature, not sampled)"
-                            ),
-                            [Field::Kind],
-                        ),
-                    ));
-                }
-                if args.kind == Kind::Coat {
-                    return Ok(Spec::Coat {
-                        size,
-                        distribution,
-                        blender_version,
-                    });
-                }
+            Kind::Albedo => {
+                reject_split_sum_flags(args)?;
+                reject_samples(args)?;
                 Ok(Spec::Albedo {
+                    size,
+                    distribution,
+                    blender_version,
+                })
+            }
+            Kind::Coat => {
+                reject_split_sum_flags(args)?;
+                reject_samples(args)?;
+                Ok(Spec::Coat {
                     size,
                     distribution,
                     blender_version,
@@ -482,6 +375,139 @@ impl Spec {
                 blender_version,
             } => coat::coat_table(size, distribution, blender_version.masking(), progress),
         }
+    }
+}
+
+/// The table's size and samples per texel, the kind's defaults where not given, checked
+/// against the limits (a coat slice against its atlas's).
+fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
+    let (default_size, default_samples) = match args.kind {
+        Kind::SplitSum => (512, 2048),
+        Kind::KullaConty => (64, 4096),
+        Kind::Albedo | Kind::Coat => (64, 1),
+    };
+    let size = args.size.unwrap_or(default_size);
+    let samples = args.samples.unwrap_or(default_samples);
+    if size == 0 || size > MAX_SIZE {
+        return Err(Error::input(
+            Field::Size,
+            size,
+            format!("texels per side from 1 to {MAX_SIZE}"),
+        ));
+    }
+    if samples == 0 || samples > MAX_SAMPLES {
+        return Err(Error::input(
+            Field::Samples,
+            samples,
+            format!("samples per texel from 1 to {MAX_SAMPLES}"),
+        ));
+    }
+    if args.kind == Kind::Coat && size > coat::MAX_SIZE {
+        return Err(Error::input(
+            Field::Size,
+            size,
+            Hint::new(
+                format!(
+                    "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
+                    coat::MAX_SIZE,
+                    crate::measure::coat::SLICES
+                ),
+                [Field::Kind],
+            ),
+        ));
+    }
+    Ok((size as usize, samples))
+}
+
+/// The split-sum table: GGX, no Blender version, and samples only for the classic method.
+fn split_sum_spec(args: &LutOptions, size: usize, samples: u32) -> Result<Spec, Error> {
+    if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
+        return Err(Error::input(
+            Field::Distribution,
+            d.key(),
+            Hint::new(
+                "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
+                [Field::Kind],
+            ),
+        ));
+    }
+    if let Some(v) = args.blender_version {
+        return Err(Error::input(
+            Field::BlenderVersion,
+            v,
+            Hint::new(
+                "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
+                [Field::Kind, Field::GModel, Field::BlenderVersion],
+            ),
+        ));
+    }
+    let estimate = match args.method.unwrap_or(Method::Quadrature) {
+        Method::Quadrature => {
+            if let Some(n) = args.samples {
+                return Err(Error::input(
+                    Field::Samples,
+                    n,
+                    Hint::new(
+                        "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
+                        [Field::Kind, Field::Method, Field::Samples, Field::Method],
+                    ),
+                ));
+            }
+            split_sum::Estimate::Quadrature(split_sum::Rule::default())
+        }
+        Method::Classic => split_sum::Estimate::Classic { samples },
+    };
+    Ok(Spec::SplitSum {
+        size,
+        g_model: args.g_model.unwrap_or(GModel::Ue4),
+        estimate,
+    })
+}
+
+/// The Blender tables (kulla-conty, albedo, coat) take their masking from the Blender
+/// version: `--g-model` and `--method` belong to split-sum.
+fn reject_split_sum_flags(args: &LutOptions) -> Result<(), Error> {
+    let kind = args.kind.key();
+    if let Some(g) = args.g_model {
+        return Err(Error::input(
+            Field::GModel,
+            g.key(),
+            Hint::new(
+                format!(
+                    "nothing with {{}} {kind} (its masking follows {{}}; {{}} applies to split-sum)"
+                ),
+                [Field::Kind, Field::BlenderVersion, Field::GModel],
+            ),
+        ));
+    }
+    if let Some(m) = args.method {
+        return Err(Error::input(
+            Field::Method,
+            m.key(),
+            Hint::new(
+                format!("nothing with {{}} {kind} ({{}} applies to split-sum)"),
+                [Field::Kind, Field::Method],
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Albedo and coat are integrated by quadrature: no samples.
+fn reject_samples(args: &LutOptions) -> Result<(), Error> {
+    match args.samples {
+        Some(n) => Err(Error::input(
+            Field::Samples,
+            n,
+            Hint::new(
+                format!(
+                    "nothing with {{}} {} (it is integrated by deterministic quadrature, not sampled)",
+                    args.kind.key()
+                ),
+                [Field::Kind],
+            ),
+        )),
+        None => Ok(()),
     }
 }
 
