@@ -561,19 +561,7 @@ pub struct LutSummary {
 pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Error> {
     let start = Instant::now();
     let spec = Spec::from_options(args)?;
-    let format = match args.format {
-        Some(f) => f,
-        None => Format::from_path(&args.out).ok_or_else(|| {
-            Error::input(
-                Field::Out,
-                args.out.display(),
-                Hint::new(
-                    "a file name ending in .exr, .dds or .ktx2 (or give {} exr|dds|ktx)",
-                    [Field::Format],
-                ),
-            )
-        })?,
-    };
+    let format = output_format(args)?;
     // A bad destination fails before minutes of computing, not after.
     check_destination(&args.out)?;
     let t = Instant::now();
@@ -589,64 +577,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         message: format!("cannot encode the table as {}: {message}", format.key()),
     })?;
     write_output(&args.out, &bytes)?;
-    let (samples, g_model, method, distribution, blender_version, channels) = match spec {
-        Spec::SplitSum {
-            g_model, estimate, ..
-        } => (
-            match estimate {
-                split_sum::Estimate::Classic { samples } => Some(samples),
-                split_sum::Estimate::Quadrature(_) => None,
-            },
-            Some(g_model),
-            Some(match estimate {
-                split_sum::Estimate::Classic { .. } => Method::Classic,
-                split_sum::Estimate::Quadrature(_) => Method::Quadrature,
-            }),
-            None,
-            None,
-            vec!["R: scale".to_string(), "G: bias".to_string()],
-        ),
-        Spec::KullaConty {
-            samples,
-            distribution,
-            blender_version,
-            ..
-        } => (
-            Some(samples),
-            None,
-            None,
-            Some(distribution),
-            Some(blender_version.to_string()),
-            vec![
-                "R: scale".to_string(),
-                "G: bias".to_string(),
-                "B: integral of f_ms cos (≈ 1 − E)".to_string(),
-                "A: E_avg(r)".to_string(),
-            ],
-        ),
-        Spec::Albedo {
-            distribution,
-            blender_version,
-            ..
-        }
-        | Spec::Coat {
-            distribution,
-            blender_version,
-            ..
-        } => (
-            None,
-            None,
-            None,
-            Some(distribution),
-            Some(blender_version.to_string()),
-            match spec {
-                Spec::Coat { .. } => ["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
-                _ => ["R: E(μ, r)", "G: E_avg(r)"],
-            }
-            .map(String::from)
-            .to_vec(),
-        ),
-    };
+    let settings = Settings::of(&spec);
     Ok(LutSummary {
         path: args.out.clone(),
         kind: args.kind,
@@ -655,17 +586,116 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         bits: args.bits,
         width: table.width,
         height: table.height,
-        channels,
-        samples,
-        g_model,
-        method,
-        distribution,
-        blender_version,
+        channels: spec
+            .channel_meanings()
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        samples: settings.samples,
+        g_model: settings.g_model,
+        method: settings.method,
+        distribution: settings.distribution,
+        blender_version: settings.blender_version,
         ior: matches!(spec, Spec::Coat { .. }).then(coat::ior),
         bytes: bytes.len(),
         compute_seconds,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The format asked for, else the one `args.out`'s extension names.
+fn output_format(args: &LutOptions) -> Result<Format, Error> {
+    match args.format {
+        Some(f) => Ok(f),
+        None => Format::from_path(&args.out).ok_or_else(|| {
+            Error::input(
+                Field::Out,
+                args.out.display(),
+                Hint::new(
+                    "a file name ending in .exr, .dds or .ktx2 (or give {} exr|dds|ktx)",
+                    [Field::Format],
+                ),
+            )
+        }),
+    }
+}
+
+/// The settings of a [`Spec`] a [`LutSummary`] reports, each where the kind has it.
+struct Settings {
+    samples: Option<u32>,
+    g_model: Option<GModel>,
+    method: Option<Method>,
+    distribution: Option<Distribution>,
+    blender_version: Option<String>,
+}
+
+impl Settings {
+    fn of(spec: &Spec) -> Self {
+        match *spec {
+            Spec::SplitSum {
+                g_model, estimate, ..
+            } => {
+                let (samples, method) = match estimate {
+                    split_sum::Estimate::Classic { samples } => (Some(samples), Method::Classic),
+                    split_sum::Estimate::Quadrature(_) => (None, Method::Quadrature),
+                };
+                Settings {
+                    samples,
+                    g_model: Some(g_model),
+                    method: Some(method),
+                    distribution: None,
+                    blender_version: None,
+                }
+            }
+            Spec::KullaConty {
+                samples,
+                distribution,
+                blender_version,
+                ..
+            } => Settings {
+                samples: Some(samples),
+                ..Settings::blender(distribution, blender_version)
+            },
+            Spec::Albedo {
+                distribution,
+                blender_version,
+                ..
+            }
+            | Spec::Coat {
+                distribution,
+                blender_version,
+                ..
+            } => Settings::blender(distribution, blender_version),
+        }
+    }
+
+    /// A table of Blender's own distribution and masking, not sampled.
+    fn blender(distribution: Distribution, blender_version: BlenderVersion) -> Self {
+        Settings {
+            samples: None,
+            g_model: None,
+            method: None,
+            distribution: Some(distribution),
+            blender_version: Some(blender_version.to_string()),
+        }
+    }
+}
+
+impl Spec {
+    /// What each stored channel holds, in order.
+    fn channel_meanings(&self) -> &'static [&'static str] {
+        match self {
+            Spec::SplitSum { .. } => &["R: scale", "G: bias"],
+            Spec::KullaConty { .. } => &[
+                "R: scale",
+                "G: bias",
+                "B: integral of f_ms cos (≈ 1 − E)",
+                "A: E_avg(r)",
+            ],
+            Spec::Coat { .. } => &["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
+            Spec::Albedo { .. } => &["R: E(μ, r)", "G: E_avg(r)"],
+        }
+    }
 }
 
 fn pixel_format_name(format: Format, bits: Bits, channels: usize) -> String {
