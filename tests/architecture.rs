@@ -192,7 +192,13 @@ fn only_the_cli_names_its_flags() {
         );
     }
     // Blender's own flags and the generated script's arguments, which the library passes.
-    let passed_on = ["--python", "--save", "--open", "--factory-startup", "--version"];
+    let passed_on = [
+        "--python",
+        "--save",
+        "--open",
+        "--factory-startup",
+        "--version",
+    ];
     let mut offenders = Vec::new();
     for crate_dir in [PHYSICS, LIBRARY] {
         for file in rust_files(&root().join(crate_dir).join("src")) {

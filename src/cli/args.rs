@@ -883,6 +883,48 @@ pub enum CoefficientsCommand {
     },
 }
 
+/// The flag that sets a library input: how the CLI names a [`Field`] in messages. A field no
+/// flag sets (a combination of inputs, a model's own parameter) keeps its own name.
+pub fn flag(field: Field) -> String {
+    let flag = match field {
+        Field::Blender => "--blender",
+        Field::BlenderVersion => "--blender-version",
+        Field::Blend => "--blend",
+        Field::Coefficients => "--coefficients",
+        Field::Color => "--color",
+        Field::Degree => "--degree",
+        Field::Distribution => "--distribution",
+        Field::Engine => "--engine",
+        Field::Extension => "--extension",
+        Field::Format => "--format",
+        Field::GModel => "--g-model",
+        Field::Into => "--into",
+        Field::Ior => "--ior",
+        Field::FitSource => "--from",
+        Field::Kind => "--kind",
+        Field::Method => "--method",
+        Field::Mode => "--mode",
+        Field::Model => "--model",
+        Field::NoProvision => "--no-provision",
+        Field::Out => "--out",
+        Field::Point => "--point",
+        Field::Report => "--report",
+        Field::Roughness => "--roughness",
+        Field::Samples => "--samples",
+        Field::Script => "--script",
+        Field::Size => "--size",
+        Field::Table => "--table",
+        Field::Timeout => "--timeout",
+        Field::ViewCosine => "--mu",
+        Field::Arguments
+        | Field::ContactSheet
+        | Field::ModelParameter(_)
+        | Field::PointRoughness
+        | Field::PointPercent => return field.name(),
+    };
+    flag.to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1008,46 +1050,4 @@ mod tests {
         }
         assert!(checked > 40, "only {checked} flags found");
     }
-}
-
-/// The flag that sets a library input: how the CLI names a [`Field`] in messages. A field no
-/// flag sets (a combination of inputs, a model's own parameter) keeps its own name.
-pub fn flag(field: Field) -> String {
-    let flag = match field {
-        Field::Blender => "--blender",
-        Field::BlenderVersion => "--blender-version",
-        Field::Blend => "--blend",
-        Field::Coefficients => "--coefficients",
-        Field::Color => "--color",
-        Field::Degree => "--degree",
-        Field::Distribution => "--distribution",
-        Field::Engine => "--engine",
-        Field::Extension => "--extension",
-        Field::Format => "--format",
-        Field::GModel => "--g-model",
-        Field::Into => "--into",
-        Field::Ior => "--ior",
-        Field::FitSource => "--from",
-        Field::Kind => "--kind",
-        Field::Method => "--method",
-        Field::Mode => "--mode",
-        Field::Model => "--model",
-        Field::NoProvision => "--no-provision",
-        Field::Out => "--out",
-        Field::Point => "--point",
-        Field::Report => "--report",
-        Field::Roughness => "--roughness",
-        Field::Samples => "--samples",
-        Field::Script => "--script",
-        Field::Size => "--size",
-        Field::Table => "--table",
-        Field::Timeout => "--timeout",
-        Field::ViewCosine => "--mu",
-        Field::Arguments
-        | Field::ContactSheet
-        | Field::ModelParameter(_)
-        | Field::PointRoughness
-        | Field::PointPercent => return field.name(),
-    };
-    flag.to_string()
 }

@@ -106,6 +106,28 @@ pub(super) fn probe_as(
     deadline: Instant,
     cancel: &Cancel,
 ) -> Result<Blender, Error> {
+    let program = resolve_program(program, source)?;
+    let mut tried = Vec::new();
+    for &k in probe_order(kind, &program) {
+        match probe_kind(&program, k, deadline, cancel)? {
+            Probed::Found(b) => return Ok(b),
+            Probed::Not(attempt) => {
+                // Something that answered like Blender must not then be fed Python code:
+                // an old Blender would take `-c CODE` for a file and open its window.
+                let blenderish = k == BlenderKind::Binary && attempt.output.contains("Blender");
+                tried.push(attempt);
+                if blenderish {
+                    break;
+                }
+            }
+        }
+    }
+    Err(neither(&program, source, &tried))
+}
+
+/// The file to run for `program`: itself, the `blender` or venv Python in a directory, or
+/// a bare command name found on PATH; made absolute.
+fn resolve_program(program: &Path, source: Source) -> Result<PathBuf, Error> {
     let named = |what: &str| {
         Error::BlenderNotFound(
             source
@@ -136,37 +158,32 @@ pub(super) fn probe_as(
     };
     // Absolute (but with symlinks kept: a venv's python must stay in its venv), so the
     // rerun command printed for a failure works from any directory.
-    let program = std::path::absolute(&program).unwrap_or(program);
+    Ok(std::path::absolute(&program).unwrap_or(program))
+}
+
+/// The kinds to try `program` as, in order: `kind` alone if given, else a Python first
+/// when its name says so.
+fn probe_order(kind: Option<BlenderKind>, program: &Path) -> &'static [BlenderKind] {
     let looks_like_python = program
         .file_name()
         .is_some_and(|n| n.to_string_lossy().starts_with("python"));
-    let order: &[BlenderKind] = match kind {
+    match kind {
         Some(BlenderKind::Binary) => &[BlenderKind::Binary],
         Some(BlenderKind::PythonModule) => &[BlenderKind::PythonModule],
         None if looks_like_python => &[BlenderKind::PythonModule, BlenderKind::Binary],
         None => &[BlenderKind::Binary, BlenderKind::PythonModule],
-    };
-    let mut tried = Vec::new();
-    for &k in order {
-        match probe_kind(&program, k, deadline, cancel)? {
-            Probed::Found(b) => return Ok(b),
-            Probed::Not(attempt) => {
-                // Something that answered like Blender must not then be fed Python code:
-                // an old Blender would take `-c CODE` for a file and open its window.
-                let blenderish = k == BlenderKind::Binary && attempt.output.contains("Blender");
-                tried.push(attempt);
-                if blenderish {
-                    break;
-                }
-            }
-        }
     }
+}
+
+/// The error for a program that answered no probe: each command tried, how it ended and
+/// the last lines it printed.
+fn neither(program: &Path, source: Source, tried: &[Attempt]) -> Error {
     let mut m = Hint::text(format!(
         " {} is neither a working Blender ({} or later) nor a Python that imports bpy",
         program.display(),
         BlenderVersion::OLDEST
     ));
-    for t in &tried {
+    for t in tried {
         m = m
             .then(Hint::text(format!("\n  `{}` ", t.command)))
             .then(t.outcome.clone());
@@ -174,11 +191,11 @@ pub(super) fn probe_as(
             m = m.then(Hint::text(format!("\n      {line}")));
         }
     }
-    Err(Error::Blender {
+    Error::Blender {
         message: source.hint().then(m),
         log: None,
         command: None,
-    })
+    }
 }
 
 struct Attempt {
@@ -200,19 +217,7 @@ fn probe_kind(
     deadline: Instant,
     cancel: &Cancel,
 ) -> Result<Probed, Error> {
-    let mut argv: Vec<OsString> = vec![program.as_os_str().to_owned()];
-    match kind {
-        BlenderKind::Binary => {
-            argv.extend(["-b", "--factory-startup", "-noaudio", "--version"].map(OsString::from))
-        }
-        BlenderKind::PythonModule => argv.extend(
-            [
-                "-c",
-                &format!("import bpy, sys; print({BPY_MARKER:?} + bpy.app.version_string)"),
-            ]
-            .map(OsString::from),
-        ),
-    }
+    let argv = probe_argv(program, kind);
     let command = shell_join(&argv);
     let not = |outcome: Hint, output: String| {
         Ok(Probed::Not(Attempt {
@@ -221,59 +226,18 @@ fn probe_kind(
             output,
         }))
     };
-    let timeout = deadline
-        .saturating_duration_since(Instant::now())
-        .min(PROBE_TIMEOUT);
-    if timeout.is_zero() {
-        return not(
-            Hint::new("was not probed: {} ran out", [Field::Timeout]),
-            String::new(),
-        );
-    }
-    let (exit, output) = match run_captured(&argv, timeout, cancel) {
-        Ok(r) => r,
-        Err(e) => return not(format!("could not be run: {e}").into(), String::new()),
+    let output = match run_probe(&argv, deadline, cancel)? {
+        Ran::Answered(output) => output,
+        Ran::Failed(outcome, output) => return not(outcome, output),
     };
-    match exit {
-        Exit::Interrupted => return Err(Error::Interrupted { log: None }),
-        Exit::TimedOut => {
-            let within = format!("did not answer within {} s", format_seconds(timeout));
-            let outcome = if timeout < PROBE_TIMEOUT {
-                Hint::text(within).then(Hint::new(" ({})", [Field::Timeout]))
-            } else {
-                Hint::text(within)
-            };
-            return not(outcome, output);
-        }
-        Exit::Finished(s) if !s.success() => return not(format!("failed ({s})").into(), output),
-        Exit::Finished(_) => {}
-    }
-    let reported = match kind {
-        BlenderKind::Binary => output
-            .lines()
-            .find_map(|l| l.trim().strip_prefix("Blender ")),
-        BlenderKind::PythonModule => output
-            .lines()
-            .find_map(|l| l.trim().strip_prefix(BPY_MARKER)),
-    };
-    let Some(version_string) = reported.map(str::trim) else {
+    let Some(version_string) = reported_version(&output, kind) else {
         return not("did not report a Blender version".into(), output);
     };
     let token = version_string.split_whitespace().next().unwrap_or("");
     let version = match token.parse::<BlenderVersion>() {
         Ok(v) => v,
         Err(_) if is_old_version(token) => {
-            return Err(Error::Blender {
-                message: format!(
-                    "{} is Blender {version_string}; gloffuse needs Blender {} or later \
-                     (older Glossy BSDFs are not modelled)",
-                    program.display(),
-                    BlenderVersion::OLDEST
-                )
-                .into(),
-                log: None,
-                command: Some(command),
-            });
+            return Err(too_old(program, version_string, command));
         }
         Err(_) => {
             return not(
@@ -288,6 +252,97 @@ fn probe_kind(
         version,
         version_string: version_string.to_string(),
     }))
+}
+
+/// The version probe's command line for `kind`.
+fn probe_argv(program: &Path, kind: BlenderKind) -> Vec<OsString> {
+    let mut argv: Vec<OsString> = vec![program.as_os_str().to_owned()];
+    match kind {
+        BlenderKind::Binary => {
+            argv.extend(["-b", "--factory-startup", "-noaudio", "--version"].map(OsString::from))
+        }
+        BlenderKind::PythonModule => argv.extend(
+            [
+                "-c",
+                &format!("import bpy, sys; print({BPY_MARKER:?} + bpy.app.version_string)"),
+            ]
+            .map(OsString::from),
+        ),
+    }
+    argv
+}
+
+/// How a probe run ended.
+enum Ran {
+    /// It exited successfully, printing this.
+    Answered(String),
+    /// It did not: how it ended, and what it printed.
+    Failed(Hint, String),
+}
+
+/// Runs `argv` for at most [`PROBE_TIMEOUT`] and not past `deadline`; `Err` only when
+/// cancelled.
+fn run_probe(argv: &[OsString], deadline: Instant, cancel: &Cancel) -> Result<Ran, Error> {
+    let timeout = deadline
+        .saturating_duration_since(Instant::now())
+        .min(PROBE_TIMEOUT);
+    if timeout.is_zero() {
+        let outcome = Hint::new("was not probed: {} ran out", [Field::Timeout]);
+        return Ok(Ran::Failed(outcome, String::new()));
+    }
+    let (exit, output) = match run_captured(argv, timeout, cancel) {
+        Ok(r) => r,
+        Err(e) => {
+            return Ok(Ran::Failed(
+                format!("could not be run: {e}").into(),
+                String::new(),
+            ));
+        }
+    };
+    match exit {
+        Exit::Interrupted => Err(Error::Interrupted { log: None }),
+        Exit::TimedOut => {
+            let within = format!("did not answer within {} s", format_seconds(timeout));
+            let outcome = if timeout < PROBE_TIMEOUT {
+                Hint::text(within).then(Hint::new(" ({})", [Field::Timeout]))
+            } else {
+                Hint::text(within)
+            };
+            Ok(Ran::Failed(outcome, output))
+        }
+        Exit::Finished(s) if !s.success() => {
+            Ok(Ran::Failed(format!("failed ({s})").into(), output))
+        }
+        Exit::Finished(_) => Ok(Ran::Answered(output)),
+    }
+}
+
+/// The version a probe's output reports: after `Blender ` (an executable) or the bpy
+/// probe's marker, trimmed.
+fn reported_version(output: &str, kind: BlenderKind) -> Option<&str> {
+    let prefix = match kind {
+        BlenderKind::Binary => "Blender ",
+        BlenderKind::PythonModule => BPY_MARKER,
+    };
+    output
+        .lines()
+        .find_map(|l| l.trim().strip_prefix(prefix))
+        .map(str::trim)
+}
+
+/// The error for a Blender older than gloffuse supports.
+fn too_old(program: &Path, version_string: &str, command: String) -> Error {
+    Error::Blender {
+        message: format!(
+            "{} is Blender {version_string}; gloffuse needs Blender {} or later \
+             (older Glossy BSDFs are not modelled)",
+            program.display(),
+            BlenderVersion::OLDEST
+        )
+        .into(),
+        log: None,
+        command: Some(command),
+    }
 }
 
 /// `2.79`, `2.93.1`: a well-formed version below 3.0.

@@ -39,28 +39,55 @@ pub(super) fn provision(
     progress: &dyn Progress,
     cancel: &Cancel,
 ) -> Result<Blender, Error> {
-    let quiet = output == InstallerOutput::Log;
     let parent = venv.parent().unwrap_or(Path::new("."));
-    let write_err = |path: &Path, e: &dyn std::fmt::Display| Error::Write {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
     // Fail before announcing or creating anything if the install cannot work.
     let python = base_python(env, cancel)?;
-    std::fs::create_dir_all(parent).map_err(|e| write_err(parent, &e))?;
+    std::fs::create_dir_all(parent).map_err(|e| write_error(parent, &e))?;
     // One install at a time: a second gloffuse (a parallel CI job sharing the cache)
     // waits for the first, then uses what it installed.
     let _lock = InstallLock::take(&parent.join(format!(".bpy-{BPY_SERIES}.lock")), progress)?;
     if venv_python(venv).exists() {
-        return probe_as(
-            &venv_python(venv),
-            Some(BlenderKind::PythonModule),
-            Source::Cache,
-            Instant::now() + PROBE_TIMEOUT,
-            cancel,
-        );
+        return probe_cached(&venv_python(venv), cancel);
     }
     remove_stale_partials(parent);
+    announce_install(venv, skipped, progress);
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".bpy-{BPY_SERIES}.partial-"))
+        .tempdir_in(parent)
+        .map_err(|e| write_error(parent, &e))?;
+    let installer = Installer {
+        venv,
+        log: (output == InstallerOutput::Log)
+            .then(|| parent.join(format!("bpy-{BPY_SERIES}-install.log"))),
+    };
+    installer.run(venv_command(python, tmp.path()))?;
+    let tmp_python = venv_python(tmp.path());
+    installer.run(pip_command(&tmp_python, installer.log.is_some()))?;
+    // Check the install before it is given the name that makes it look valid.
+    probe_cached(&tmp_python, cancel)?;
+    move_into_place(tmp, venv, cancel)
+}
+
+fn write_error(path: &Path, e: &dyn std::fmt::Display) -> Error {
+    Error::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Probes the bpy of a venv in the cache.
+fn probe_cached(python: &Path, cancel: &Cancel) -> Result<Blender, Error> {
+    probe_as(
+        python,
+        Some(BlenderKind::PythonModule),
+        Source::Cache,
+        Instant::now() + PROBE_TIMEOUT,
+        cancel,
+    )
+}
+
+/// Says, through `progress`, which Blenders are not used and that bpy is being installed.
+fn announce_install(venv: &Path, skipped: &[Hint], progress: &dyn Progress) {
     for s in skipped {
         progress.advise(&Hint::text("not using ").then(s.clone()));
     }
@@ -72,72 +99,20 @@ pub(super) fn provision(
         ),
         [Field::Blender],
     ));
-    let tmp = tempfile::Builder::new()
-        .prefix(&format!(".bpy-{BPY_SERIES}.partial-"))
-        .tempdir_in(parent)
-        .map_err(|e| write_err(parent, &e))?;
-    let log_path = parent.join(format!("bpy-{BPY_SERIES}-install.log"));
-    let step = |argv: Vec<OsString>| -> Result<(), Error> {
-        let command = shell_join(&argv);
-        let mut cmd = Command::new(&argv[0]);
-        cmd.args(&argv[1..]).stdin(Stdio::null());
-        let (out, log) = if quiet {
-            let f = File::create(&log_path).map_err(|e| write_err(&log_path, &e))?;
-            (f, Some(log_path.clone()))
-        } else {
-            let fd = std::io::stderr()
-                .as_fd()
-                .try_clone_to_owned()
-                .map_err(|e| write_err(Path::new("<stderr>"), &e))?;
-            (File::from(fd), None)
-        };
-        let status = cmd
-            .stdout(
-                out.try_clone()
-                    .map_err(|e| write_err(Path::new("<stderr>"), &e))?,
-            )
-            .stderr(out)
-            .status();
-        let fail = |what: String| {
-            let mut message = format!(
-                "installing bpy {BPY_SERIES} into {} failed: {what}",
-                venv.display()
-            );
-            if let Some(l) = &log {
-                let text = std::fs::read(l)
-                    .map(|b| String::from_utf8_lossy(&b).into_owned())
-                    .unwrap_or_default();
-                for line in last_lines(&text, 8) {
-                    message.push_str("\n    ");
-                    message.push_str(line);
-                }
-            }
-            let advice = Hint::new(
-                format!(
-                    "\n  (bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or \
-                     point {{}} or {ENV_VAR} at a Blender)"
-                ),
-                [Field::Blender],
-            );
-            Error::Blender {
-                message: Hint::text(message).then(advice),
-                log: log.clone(),
-                command: Some(command.clone()),
-            }
-        };
-        match status {
-            Ok(s) if s.success() => Ok(()),
-            Ok(s) => Err(fail(format!("{s}"))),
-            Err(e) => Err(fail(e.to_string())),
-        }
-    };
-    let mut make_venv: Vec<OsString> = vec![python.into_os_string()];
-    make_venv.extend(["-m", "venv"].map(OsString::from));
-    make_venv.push(tmp.path().as_os_str().to_owned());
-    step(make_venv)?;
-    let tmp_python = venv_python(tmp.path());
-    let mut pip: Vec<OsString> = vec![tmp_python.clone().into_os_string()];
-    pip.extend(
+}
+
+/// `python -m venv DIR`.
+fn venv_command(python: PathBuf, dir: &Path) -> Vec<OsString> {
+    let mut argv: Vec<OsString> = vec![python.into_os_string()];
+    argv.extend(["-m", "venv"].map(OsString::from));
+    argv.push(dir.as_os_str().to_owned());
+    argv
+}
+
+/// `python -m pip install … [-q] REQUIREMENT` (`-q` when the output goes to the log).
+fn pip_command(python: &Path, quiet: bool) -> Vec<OsString> {
+    let mut argv: Vec<OsString> = vec![python.as_os_str().to_owned()];
+    argv.extend(
         [
             "-m",
             "pip",
@@ -148,37 +123,101 @@ pub(super) fn provision(
         .map(OsString::from),
     );
     if quiet {
-        pip.push("-q".into());
+        argv.push("-q".into());
     }
-    pip.push(BPY_REQUIREMENT.into());
-    step(pip)?;
-    // Check the install before it is given the name that makes it look valid.
-    probe_as(
-        &tmp_python,
-        Some(BlenderKind::PythonModule),
-        Source::Cache,
-        Instant::now() + PROBE_TIMEOUT,
-        cancel,
-    )?;
+    argv.push(BPY_REQUIREMENT.into());
+    argv
+}
+
+/// Renames the checked install in `tmp` to `venv` and probes it there; a venv that does
+/// not work under its final name is removed.
+fn move_into_place(tmp: tempfile::TempDir, venv: &Path, cancel: &Cancel) -> Result<Blender, Error> {
     if let Err(e) = std::fs::rename(tmp.path(), venv) {
         // Another gloffuse may have finished first; use its venv (ours is removed on drop).
         if !venv_python(venv).exists() {
-            return Err(write_err(venv, &e));
+            return Err(write_error(venv, &e));
         }
     } else {
         let _ = tmp.keep();
     }
-    match probe_as(
-        &venv_python(venv),
-        Some(BlenderKind::PythonModule),
-        Source::Cache,
-        Instant::now() + PROBE_TIMEOUT,
-        cancel,
-    ) {
+    match probe_cached(&venv_python(venv), cancel) {
         Ok(b) => Ok(b),
         Err(e) => {
             let _ = std::fs::remove_dir_all(venv);
             Err(e)
+        }
+    }
+}
+
+/// Runs the install's steps (making the venv, pip) for `venv`.
+struct Installer<'a> {
+    venv: &'a Path,
+    /// The install log the steps write to, quoted in an error; none when their output
+    /// goes to stderr ([`InstallerOutput::Stderr`]).
+    log: Option<PathBuf>,
+}
+
+impl Installer<'_> {
+    /// Runs one step, its output to the log (made afresh) or to stderr.
+    fn run(&self, argv: Vec<OsString>) -> Result<(), Error> {
+        let command = shell_join(&argv);
+        let mut cmd = Command::new(&argv[0]);
+        cmd.args(&argv[1..]).stdin(Stdio::null());
+        let out = self.output()?;
+        let status = cmd
+            .stdout(
+                out.try_clone()
+                    .map_err(|e| write_error(Path::new("<stderr>"), &e))?,
+            )
+            .stderr(out)
+            .status();
+        match status {
+            Ok(s) if s.success() => Ok(()),
+            Ok(s) => Err(self.failure(format!("{s}"), command)),
+            Err(e) => Err(self.failure(e.to_string(), command)),
+        }
+    }
+
+    /// Where a step's output goes: the log, truncated, or a duplicate of stderr.
+    fn output(&self) -> Result<File, Error> {
+        match &self.log {
+            Some(log) => File::create(log).map_err(|e| write_error(log, &e)),
+            None => {
+                let fd = std::io::stderr()
+                    .as_fd()
+                    .try_clone_to_owned()
+                    .map_err(|e| write_error(Path::new("<stderr>"), &e))?;
+                Ok(File::from(fd))
+            }
+        }
+    }
+
+    /// The error of a step that failed with `what`: the log's last lines, and advice.
+    fn failure(&self, what: String, command: String) -> Error {
+        let mut message = format!(
+            "installing bpy {BPY_SERIES} into {} failed: {what}",
+            self.venv.display()
+        );
+        if let Some(l) = &self.log {
+            let text = std::fs::read(l)
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+                .unwrap_or_default();
+            for line in last_lines(&text, 8) {
+                message.push_str("\n    ");
+                message.push_str(line);
+            }
+        }
+        let advice = Hint::new(
+            format!(
+                "\n  (bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or \
+                 point {{}} or {ENV_VAR} at a Blender)"
+            ),
+            [Field::Blender],
+        );
+        Error::Blender {
+            message: Hint::text(message).then(advice),
+            log: self.log.clone(),
+            command: Some(command),
         }
     }
 }

@@ -19,7 +19,7 @@ use serde::Serialize;
 use std::ffi::OsString;
 use std::path::PathBuf;
 
-use crate::blender::{BlenderOptions, Run, command_line, run_script};
+use crate::blender::{Blender, BlenderOptions, Run, command_line, run_script};
 use crate::error::{Error, Field, Hint};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
@@ -183,73 +183,15 @@ fn engines_of(
 pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
     // Inputs and coefficients are checked before Blender is looked for: bad input fails fast.
     check_inputs(g)?;
-    let pinned = g
-        .coefficients
-        .as_deref()
-        .map(|name| Coefficients::load(name).map(|c| (c, name)))
-        .transpose()?;
+    let pinned = pinned_coefficients(g)?;
     let engines = engines_of(g, pinned.as_ref().map(|(c, name)| (c, *name)))?;
-    let needs_blender = g.blend.is_some() || g.into.is_some() || g.extension.is_some();
-    let blender = if needs_blender {
-        let blender = g.blender.find(progress)?;
-        if g.extension.is_some() {
-            extension::can_build(blender.version)?;
-        }
-        Some(blender)
-    } else {
-        None
-    };
-    // The script carries both masking families and picks the one of the Blender it runs
-    // in, so one script serves every version.
-    let curves = match &pinned {
-        Some((coefficients, name)) => Curves::Pinned { coefficients, name },
-        None => Curves::Presets(&engines),
-    };
-    let mut params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
-    // A new library (.blend or extension) gets previews, and the catalogs of the
-    // definition file beside the .blend (the user's own catalog for one of our paths wins);
-    // `--into` keeps the user's file as it is apart from the groups, and a script leaves
-    // both to the Blender it runs in.
-    let catalogs_file = match &g.blend {
-        Some(blend) => catalogs_beside(blend)?,
-        None => None,
-    };
-    let mut catalogs_text = None;
-    if let Some(file) = &catalogs_file {
-        let existing = match std::fs::read_to_string(file) {
-            Ok(text) => Some(text),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-            Err(source) => {
-                return Err(Error::Read {
-                    path: file.clone(),
-                    source,
-                });
-            }
-        };
-        let (merged, text) = params.catalogs.merge(existing.as_deref());
-        params.catalogs = merged;
-        catalogs_text = Some(text);
-    }
-    params.previews = g.blend.is_some() || g.extension.is_some();
+    let blender = blender_for(g, progress)?;
+    let mut params = script_params(g, pinned.as_ref(), &engines)?;
+    let catalogs = merge_catalogs(g, &mut params)?;
     let script = assemble(&params, Job::Generate);
     let mut out = Generated {
         blender: blender.as_ref().map(|b| b.version_string.clone()),
-        coefficients: match (&pinned, &blender) {
-            (Some((_, name)), _) => name.to_string(),
-            (None, blender) => engines
-                .iter()
-                .map(|&engine| match (engine, blender) {
-                    (Engine::Eevee, _) => preset_for(engine, BlenderVersion::OLDEST).to_string(),
-                    (Engine::Cycles, Some(b)) => preset_for(engine, b.version).to_string(),
-                    (Engine::Cycles, None) => format!(
-                        "{} or {}, for the Blender the script runs in",
-                        preset_for(engine, BlenderVersion::OLDEST),
-                        preset_for(engine, BlenderVersion::HEIGHT_CORRELATED_FROM)
-                    ),
-                })
-                .collect::<Vec<_>>()
-                .join("; "),
-        },
+        coefficients: coefficients_label(pinned.as_ref(), &engines, blender.as_ref()),
         script: None,
         blend: None,
         backup: None,
@@ -259,13 +201,134 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         log: None,
     };
     let Some(blender) = blender else {
-        if let Some(path) = &g.script {
-            write_output(path, script.as_bytes())?;
-            out.script = Some(path.clone());
-        }
+        write_script(g, &script, &mut out)?;
         return Ok(out);
     };
+    let built = run_blender(g, &blender, &script)?;
+    out.log = Some(built.log.clone());
+    // Everything is made before anything is written: a failed run leaves no output at all.
+    let package = package_extension(g, &built, &params, &blender)?;
+    write_script(g, &script, &mut out)?;
+    if let (Some(zip), Some(bytes)) = (&g.extension, &package) {
+        write_output(zip, bytes)?;
+        out.extension = Some(zip.clone());
+    }
+    install_blend(g, built, &mut out)?;
+    write_catalogs(catalogs, &mut out)?;
+    Ok(out)
+}
 
+/// The coefficients `g` pins, with the name they were given by.
+fn pinned_coefficients(g: &GenerateOptions) -> Result<Option<(Coefficients, &str)>, Error> {
+    g.coefficients
+        .as_deref()
+        .map(|name| Coefficients::load(name).map(|c| (c, name)))
+        .transpose()
+}
+
+/// The Blender to run when a .blend or an extension is asked for (a script needs none);
+/// it must be able to build an extension if one is asked for.
+fn blender_for(g: &GenerateOptions, progress: &dyn Progress) -> Result<Option<Blender>, Error> {
+    let needs_blender = g.blend.is_some() || g.into.is_some() || g.extension.is_some();
+    if !needs_blender {
+        return Ok(None);
+    }
+    let blender = g.blender.find(progress)?;
+    if g.extension.is_some() {
+        extension::can_build(blender.version)?;
+    }
+    Ok(Some(blender))
+}
+
+/// The script's parameters: the pinned coefficients' curves or every engine's presets;
+/// previews only for a new library (.blend or extension).
+fn script_params(
+    g: &GenerateOptions,
+    pinned: Option<&(Coefficients, &str)>,
+    engines: &[Engine],
+) -> Result<GenerateParams, Error> {
+    // The script carries both masking families and picks the one of the Blender it runs
+    // in, so one script serves every version.
+    let curves = match pinned {
+        Some((coefficients, name)) => Curves::Pinned { coefficients, name },
+        None => Curves::Presets(engines),
+    };
+    let mut params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
+    params.previews = g.blend.is_some() || g.extension.is_some();
+    Ok(params)
+}
+
+/// A new .blend gets the catalogs of the definition file beside it (the user's own catalog
+/// for one of our paths wins): merges them into `params` and returns the file and its
+/// merged text, to write once the .blend is in place. `--into` keeps the user's file as it
+/// is apart from the groups, and a script leaves both to the Blender it runs in.
+fn merge_catalogs(
+    g: &GenerateOptions,
+    params: &mut GenerateParams,
+) -> Result<Option<(PathBuf, String)>, Error> {
+    let Some(file) = (match &g.blend {
+        Some(blend) => catalogs_beside(blend)?,
+        None => None,
+    }) else {
+        return Ok(None);
+    };
+    let existing = match std::fs::read_to_string(&file) {
+        Ok(text) => Some(text),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(source) => return Err(Error::Read { path: file, source }),
+    };
+    let (merged, text) = params.catalogs.merge(existing.as_deref());
+    params.catalogs = merged;
+    Ok(Some((file, text)))
+}
+
+/// The coefficients the groups use, as [`Generated`] names them: the pinned ones, else
+/// each engine's preset (for Cycles without a Blender, both it may pick).
+fn coefficients_label(
+    pinned: Option<&(Coefficients, &str)>,
+    engines: &[Engine],
+    blender: Option<&Blender>,
+) -> String {
+    if let Some((_, name)) = pinned {
+        return name.to_string();
+    }
+    engines
+        .iter()
+        .map(|&engine| match (engine, blender) {
+            (Engine::Eevee, _) => preset_for(engine, BlenderVersion::OLDEST).to_string(),
+            (Engine::Cycles, Some(b)) => preset_for(engine, b.version).to_string(),
+            (Engine::Cycles, None) => format!(
+                "{} or {}, for the Blender the script runs in",
+                preset_for(engine, BlenderVersion::OLDEST),
+                preset_for(engine, BlenderVersion::HEIGHT_CORRELATED_FROM)
+            ),
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Writes the script if one is asked for.
+fn write_script(g: &GenerateOptions, script: &str, out: &mut Generated) -> Result<(), Error> {
+    if let Some(path) = &g.script {
+        write_output(path, script.as_bytes())?;
+        out.script = Some(path.clone());
+    }
+    Ok(())
+}
+
+/// What a Blender run made: the saved .blend under a temporary name, and where it goes.
+struct Built {
+    /// The .blend Blender saved, beside its destination or in the run folder.
+    tmp: tempfile::TempPath,
+    /// The new library or the file changed in place, if any (an extension alone has none).
+    dest: Option<PathBuf>,
+    target: Destination,
+    log: PathBuf,
+}
+
+/// Runs the script in `blender`, saving the .blend under a temporary name, and checks that
+/// Blender wrote a whole .blend.
+fn run_blender(g: &GenerateOptions, blender: &Blender, script: &str) -> Result<Built, Error> {
     let run_dir = crate::blender::runs::new_run_dir("generate")?;
     let script_path = run_dir.join("gloffuse-generate.py");
     write_output(&script_path, script.as_bytes())?;
@@ -289,7 +352,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     args.extend([OsString::from("--save"), tmp.to_path_buf().into_os_string()]);
     let log = run_dir.join("blender.log");
     let run = Run {
-        blender: &blender,
+        blender,
         script: &script_path,
         args,
         timeout: g.blender.timeout,
@@ -304,29 +367,44 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
             command: Some(command_line(&run)),
         });
     }
-    out.log = Some(log);
-    // Everything is made before anything is written: a failed run leaves no output at all.
-    let package = match &g.extension {
-        Some(_) => {
-            let blend = std::fs::read(&tmp).map_err(|source| Error::Read {
-                path: tmp.to_path_buf(),
-                source,
-            })?;
-            let catalogs = params.catalogs.definition_file();
-            Some(extension::package(&blend, &catalogs, blender.version)?)
-        }
-        None => None,
-    };
-    if let Some(path) = &g.script {
-        write_output(path, script.as_bytes())?;
-        out.script = Some(path.clone());
+    Ok(Built {
+        tmp,
+        dest,
+        target,
+        log,
+    })
+}
+
+/// The extension's .zip in memory, if one is asked for: the saved .blend and its catalogs.
+fn package_extension(
+    g: &GenerateOptions,
+    built: &Built,
+    params: &GenerateParams,
+    blender: &Blender,
+) -> Result<Option<Vec<u8>>, Error> {
+    if g.extension.is_none() {
+        return Ok(None);
     }
-    if let (Some(zip), Some(bytes)) = (&g.extension, &package) {
-        write_output(zip, bytes)?;
-        out.extension = Some(zip.clone());
-    }
+    let blend = std::fs::read(&built.tmp).map_err(|source| Error::Read {
+        path: built.tmp.to_path_buf(),
+        source,
+    })?;
+    let catalogs = params.catalogs.definition_file();
+    Ok(Some(extension::package(
+        &blend,
+        &catalogs,
+        blender.version,
+    )?))
+}
+
+/// Puts the saved .blend in its destination, if it has one: renamed over the file (after a backup of a
+/// file changed in place), or copied to a stream.
+fn install_blend(g: &GenerateOptions, built: Built, out: &mut Generated) -> Result<(), Error> {
+    let Built {
+        tmp, dest, target, ..
+    } = built;
     let Some(dest) = dest else {
-        return Ok(out);
+        return Ok(());
     };
     if let (Some(_), Destination::File(real)) = (&g.into, &target) {
         // Blender's own convention: the previous version stays beside the file as .blend1.
@@ -352,12 +430,17 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
             write_output(&dest, &bytes)?;
         }
     }
-    if let (Some(file), Some(text)) = (&catalogs_file, &catalogs_text) {
-        write_output(file, text.as_bytes())?;
-        out.catalogs = Some(file.clone());
-    }
     out.blend = Some(dest);
-    Ok(out)
+    Ok(())
+}
+
+/// Writes the merged catalog definition file beside the new .blend, if there is one.
+fn write_catalogs(catalogs: Option<(PathBuf, String)>, out: &mut Generated) -> Result<(), Error> {
+    if let Some((file, text)) = catalogs {
+        write_output(&file, text.as_bytes())?;
+        out.catalogs = Some(file);
+    }
+    Ok(())
 }
 
 /// Where the catalog definition file of the library `blend` lives: beside the file it

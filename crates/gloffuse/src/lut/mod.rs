@@ -293,140 +293,33 @@ pub enum Spec {
 impl Spec {
     /// Checks the numbers and the flag combinations; errors name the flag.
     pub fn from_options(args: &LutOptions) -> Result<Spec, Error> {
-        let (default_size, default_samples) = match args.kind {
-            Kind::SplitSum => (512, 2048),
-            Kind::KullaConty => (64, 4096),
-            Kind::Albedo | Kind::Coat => (64, 1),
-        };
-        let size = args.size.unwrap_or(default_size);
-        let samples = args.samples.unwrap_or(default_samples);
-        if size == 0 || size > MAX_SIZE {
-            return Err(Error::input(
-                Field::Size,
-                size,
-                format!("texels per side from 1 to {MAX_SIZE}"),
-            ));
-        }
-        if samples == 0 || samples > MAX_SAMPLES {
-            return Err(Error::input(
-                Field::Samples,
-                samples,
-                format!("samples per texel from 1 to {MAX_SAMPLES}"),
-            ));
-        }
-        if args.kind == Kind::Coat && size > coat::MAX_SIZE {
-            return Err(Error::input(
-                Field::Size,
-                size,
-                Hint::new(
-                    format!(
-                        "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
-                        coat::MAX_SIZE,
-                        crate::measure::coat::SLICES
-                    ),
-                    [Field::Kind],
-                ),
-            ));
-        }
-        let size = size as usize;
+        let (size, samples) = checked_counts(args)?;
+        let distribution = args.distribution.unwrap_or(Distribution::Ggx);
+        let blender_version = args.blender_version.unwrap_or(BlenderVersion::DEFAULT);
         match args.kind {
-            Kind::SplitSum => {
-                if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
-                    return Err(Error::input(
-                        Field::Distribution,
-                        d.key(),
-                        Hint::new(
-                            "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
-                            [Field::Kind],
-                        ),
-                    ));
-                }
-                if let Some(v) = args.blender_version {
-                    return Err(Error::input(
-                        Field::BlenderVersion,
-                        v,
-                        Hint::new(
-                            "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
-                            [Field::Kind, Field::GModel, Field::BlenderVersion],
-                        ),
-                    ));
-                }
-                let estimate = match args.method.unwrap_or(Method::Quadrature) {
-                    Method::Quadrature => {
-                        if let Some(n) = args.samples {
-                            return Err(Error::input(
-                                Field::Samples,
-                                n,
-                                Hint::new(
-                                    "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
-                                    [Field::Kind, Field::Method, Field::Samples, Field::Method],
-                                ),
-                            ));
-                        }
-                        split_sum::Estimate::Quadrature(split_sum::Rule::default())
-                    }
-                    Method::Classic => split_sum::Estimate::Classic { samples },
-                };
-                Ok(Spec::SplitSum {
+            Kind::SplitSum => split_sum_spec(args, size, samples),
+            Kind::KullaConty => {
+                reject_split_sum_flags(args)?;
+                Ok(Spec::KullaConty {
                     size,
-                    g_model: args.g_model.unwrap_or(GModel::Ue4),
-                    estimate,
+                    samples,
+                    distribution,
+                    blender_version,
                 })
             }
-            Kind::KullaConty | Kind::Albedo | Kind::Coat => {
-                let kind = args.kind.key();
-                if let Some(g) = args.g_model {
-                    return Err(Error::input(
-                        Field::GModel,
-                        g.key(),
-                        Hint::new(
-                            format!(
-                                "nothing with {{}} {kind} (its masking follows {{}}; {{}} applies to split-sum)"
-                            ),
-                            [Field::Kind, Field::BlenderVersion, Field::GModel],
-                        ),
-                    ));
-                }
-                if let Some(m) = args.method {
-                    return Err(Error::input(
-                        Field::Method,
-                        m.key(),
-                        Hint::new(
-                            format!("nothing with {{}} {kind} ({{}} applies to split-sum)"),
-                            [Field::Kind, Field::Method],
-                        ),
-                    ));
-                }
-                let distribution = args.distribution.unwrap_or(Distribution::Ggx);
-                let blender_version = args.blender_version.unwrap_or(BlenderVersion::DEFAULT);
-                if args.kind == Kind::KullaConty {
-                    return Ok(Spec::KullaConty {
-                        size,
-                        samples,
-                        distribution,
-                        blender_version,
-                    });
-                }
-                if let Some(n) = args.samples {
-                    return Err(Error::input(
-                        Field::Samples,
-                        n,
-                        Hint::new(
-                            format!(
-                                "nothing with {{}} {kind} (it is integrated by deterministic quadrature, not sampled)"
-                            ),
-                            [Field::Kind],
-                        ),
-                    ));
-                }
-                if args.kind == Kind::Coat {
-                    return Ok(Spec::Coat {
-                        size,
-                        distribution,
-                        blender_version,
-                    });
-                }
+            Kind::Albedo => {
+                reject_split_sum_flags(args)?;
+                reject_samples(args)?;
                 Ok(Spec::Albedo {
+                    size,
+                    distribution,
+                    blender_version,
+                })
+            }
+            Kind::Coat => {
+                reject_split_sum_flags(args)?;
+                reject_samples(args)?;
+                Ok(Spec::Coat {
                     size,
                     distribution,
                     blender_version,
@@ -485,6 +378,139 @@ impl Spec {
     }
 }
 
+/// The table's size and samples per texel, the kind's defaults where not given, checked
+/// against the limits (a coat slice against its atlas's).
+fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
+    let (default_size, default_samples) = match args.kind {
+        Kind::SplitSum => (512, 2048),
+        Kind::KullaConty => (64, 4096),
+        Kind::Albedo | Kind::Coat => (64, 1),
+    };
+    let size = args.size.unwrap_or(default_size);
+    let samples = args.samples.unwrap_or(default_samples);
+    if size == 0 || size > MAX_SIZE {
+        return Err(Error::input(
+            Field::Size,
+            size,
+            format!("texels per side from 1 to {MAX_SIZE}"),
+        ));
+    }
+    if samples == 0 || samples > MAX_SAMPLES {
+        return Err(Error::input(
+            Field::Samples,
+            samples,
+            format!("samples per texel from 1 to {MAX_SAMPLES}"),
+        ));
+    }
+    if args.kind == Kind::Coat && size > coat::MAX_SIZE {
+        return Err(Error::input(
+            Field::Size,
+            size,
+            Hint::new(
+                format!(
+                    "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
+                    coat::MAX_SIZE,
+                    crate::measure::coat::SLICES
+                ),
+                [Field::Kind],
+            ),
+        ));
+    }
+    Ok((size as usize, samples))
+}
+
+/// The split-sum table: GGX, no Blender version, and samples only for the classic method.
+fn split_sum_spec(args: &LutOptions, size: usize, samples: u32) -> Result<Spec, Error> {
+    if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
+        return Err(Error::input(
+            Field::Distribution,
+            d.key(),
+            Hint::new(
+                "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
+                [Field::Kind],
+            ),
+        ));
+    }
+    if let Some(v) = args.blender_version {
+        return Err(Error::input(
+            Field::BlenderVersion,
+            v,
+            Hint::new(
+                "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
+                [Field::Kind, Field::GModel, Field::BlenderVersion],
+            ),
+        ));
+    }
+    let estimate = match args.method.unwrap_or(Method::Quadrature) {
+        Method::Quadrature => {
+            if let Some(n) = args.samples {
+                return Err(Error::input(
+                    Field::Samples,
+                    n,
+                    Hint::new(
+                        "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
+                        [Field::Kind, Field::Method, Field::Samples, Field::Method],
+                    ),
+                ));
+            }
+            split_sum::Estimate::Quadrature(split_sum::Rule::default())
+        }
+        Method::Classic => split_sum::Estimate::Classic { samples },
+    };
+    Ok(Spec::SplitSum {
+        size,
+        g_model: args.g_model.unwrap_or(GModel::Ue4),
+        estimate,
+    })
+}
+
+/// The Blender tables (kulla-conty, albedo, coat) take their masking from the Blender
+/// version: `--g-model` and `--method` belong to split-sum.
+fn reject_split_sum_flags(args: &LutOptions) -> Result<(), Error> {
+    let kind = args.kind.key();
+    if let Some(g) = args.g_model {
+        return Err(Error::input(
+            Field::GModel,
+            g.key(),
+            Hint::new(
+                format!(
+                    "nothing with {{}} {kind} (its masking follows {{}}; {{}} applies to split-sum)"
+                ),
+                [Field::Kind, Field::BlenderVersion, Field::GModel],
+            ),
+        ));
+    }
+    if let Some(m) = args.method {
+        return Err(Error::input(
+            Field::Method,
+            m.key(),
+            Hint::new(
+                format!("nothing with {{}} {kind} ({{}} applies to split-sum)"),
+                [Field::Kind, Field::Method],
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Albedo and coat are integrated by quadrature: no samples.
+fn reject_samples(args: &LutOptions) -> Result<(), Error> {
+    match args.samples {
+        Some(n) => Err(Error::input(
+            Field::Samples,
+            n,
+            Hint::new(
+                format!(
+                    "nothing with {{}} {} (it is integrated by deterministic quadrature, not sampled)",
+                    args.kind.key()
+                ),
+                [Field::Kind],
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Encodes a table in memory as a file of the given format and bit depth (an error is the
 /// encoder's message; it does not happen for tables that [`Spec::compute`] makes).
 pub fn encode(table: &Table, format: Format, bits: Bits) -> Result<Vec<u8>, String> {
@@ -535,19 +561,7 @@ pub struct LutSummary {
 pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Error> {
     let start = Instant::now();
     let spec = Spec::from_options(args)?;
-    let format = match args.format {
-        Some(f) => f,
-        None => Format::from_path(&args.out).ok_or_else(|| {
-            Error::input(
-                Field::Out,
-                args.out.display(),
-                Hint::new(
-                    "a file name ending in .exr, .dds or .ktx2 (or give {} exr|dds|ktx)",
-                    [Field::Format],
-                ),
-            )
-        })?,
-    };
+    let format = output_format(args)?;
     // A bad destination fails before minutes of computing, not after.
     check_destination(&args.out)?;
     let t = Instant::now();
@@ -563,64 +577,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         message: format!("cannot encode the table as {}: {message}", format.key()),
     })?;
     write_output(&args.out, &bytes)?;
-    let (samples, g_model, method, distribution, blender_version, channels) = match spec {
-        Spec::SplitSum {
-            g_model, estimate, ..
-        } => (
-            match estimate {
-                split_sum::Estimate::Classic { samples } => Some(samples),
-                split_sum::Estimate::Quadrature(_) => None,
-            },
-            Some(g_model),
-            Some(match estimate {
-                split_sum::Estimate::Classic { .. } => Method::Classic,
-                split_sum::Estimate::Quadrature(_) => Method::Quadrature,
-            }),
-            None,
-            None,
-            vec!["R: scale".to_string(), "G: bias".to_string()],
-        ),
-        Spec::KullaConty {
-            samples,
-            distribution,
-            blender_version,
-            ..
-        } => (
-            Some(samples),
-            None,
-            None,
-            Some(distribution),
-            Some(blender_version.to_string()),
-            vec![
-                "R: scale".to_string(),
-                "G: bias".to_string(),
-                "B: integral of f_ms cos (≈ 1 − E)".to_string(),
-                "A: E_avg(r)".to_string(),
-            ],
-        ),
-        Spec::Albedo {
-            distribution,
-            blender_version,
-            ..
-        }
-        | Spec::Coat {
-            distribution,
-            blender_version,
-            ..
-        } => (
-            None,
-            None,
-            None,
-            Some(distribution),
-            Some(blender_version.to_string()),
-            match spec {
-                Spec::Coat { .. } => ["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
-                _ => ["R: E(μ, r)", "G: E_avg(r)"],
-            }
-            .map(String::from)
-            .to_vec(),
-        ),
-    };
+    let settings = Settings::of(&spec);
     Ok(LutSummary {
         path: args.out.clone(),
         kind: args.kind,
@@ -629,17 +586,116 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         bits: args.bits,
         width: table.width,
         height: table.height,
-        channels,
-        samples,
-        g_model,
-        method,
-        distribution,
-        blender_version,
+        channels: spec
+            .channel_meanings()
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        samples: settings.samples,
+        g_model: settings.g_model,
+        method: settings.method,
+        distribution: settings.distribution,
+        blender_version: settings.blender_version,
         ior: matches!(spec, Spec::Coat { .. }).then(coat::ior),
         bytes: bytes.len(),
         compute_seconds,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The format asked for, else the one `args.out`'s extension names.
+fn output_format(args: &LutOptions) -> Result<Format, Error> {
+    match args.format {
+        Some(f) => Ok(f),
+        None => Format::from_path(&args.out).ok_or_else(|| {
+            Error::input(
+                Field::Out,
+                args.out.display(),
+                Hint::new(
+                    "a file name ending in .exr, .dds or .ktx2 (or give {} exr|dds|ktx)",
+                    [Field::Format],
+                ),
+            )
+        }),
+    }
+}
+
+/// The settings of a [`Spec`] a [`LutSummary`] reports, each where the kind has it.
+struct Settings {
+    samples: Option<u32>,
+    g_model: Option<GModel>,
+    method: Option<Method>,
+    distribution: Option<Distribution>,
+    blender_version: Option<String>,
+}
+
+impl Settings {
+    fn of(spec: &Spec) -> Self {
+        match *spec {
+            Spec::SplitSum {
+                g_model, estimate, ..
+            } => {
+                let (samples, method) = match estimate {
+                    split_sum::Estimate::Classic { samples } => (Some(samples), Method::Classic),
+                    split_sum::Estimate::Quadrature(_) => (None, Method::Quadrature),
+                };
+                Settings {
+                    samples,
+                    g_model: Some(g_model),
+                    method: Some(method),
+                    distribution: None,
+                    blender_version: None,
+                }
+            }
+            Spec::KullaConty {
+                samples,
+                distribution,
+                blender_version,
+                ..
+            } => Settings {
+                samples: Some(samples),
+                ..Settings::blender(distribution, blender_version)
+            },
+            Spec::Albedo {
+                distribution,
+                blender_version,
+                ..
+            }
+            | Spec::Coat {
+                distribution,
+                blender_version,
+                ..
+            } => Settings::blender(distribution, blender_version),
+        }
+    }
+
+    /// A table of Blender's own distribution and masking, not sampled.
+    fn blender(distribution: Distribution, blender_version: BlenderVersion) -> Self {
+        Settings {
+            samples: None,
+            g_model: None,
+            method: None,
+            distribution: Some(distribution),
+            blender_version: Some(blender_version.to_string()),
+        }
+    }
+}
+
+impl Spec {
+    /// What each stored channel holds, in order.
+    fn channel_meanings(&self) -> &'static [&'static str] {
+        match self {
+            Spec::SplitSum { .. } => &["R: scale", "G: bias"],
+            Spec::KullaConty { .. } => &[
+                "R: scale",
+                "G: bias",
+                "B: integral of f_ms cos (≈ 1 − E)",
+                "A: E_avg(r)",
+            ],
+            Spec::Coat { .. } => &["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
+            Spec::Albedo { .. } => &["R: E(μ, r)", "G: E_avg(r)"],
+        }
+    }
 }
 
 fn pixel_format_name(format: Format, bits: Bits, channels: usize) -> String {

@@ -433,6 +433,7 @@ impl QuadraturePixel {
 /// `(scale, bias)` of one texel by the quadrature in f32 lanes, summed in f64 per azimuth
 /// and per tail block. Same nodes and formulas as [`texel_f64`].
 #[inline(always)]
+// Long on purpose: one hot loop nest whose f32 lanes must vectorise, kept node by node beside texel_f64.
 fn quadrature_kernel<const HC: bool>(
     row: &QuadratureRow,
     g_model: GModel,

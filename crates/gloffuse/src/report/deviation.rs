@@ -91,47 +91,94 @@ pub fn cell_image(rendered: &Rendered, index: usize, targets: &[[f64; 3]]) -> Ve
 /// scale's legend.
 pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(), Error> {
     register_font().map_err(|m| write_error(out, m))?;
-    let plan = &rendered.plan;
-    let cell = plan.settings.cell as usize;
-    let rows: Vec<_> = report
-        .rows
-        .iter()
-        .map(|row| (row, plan.rows[row.id].corrected))
-        .collect();
-    let series: Vec<String> = {
-        let mut s: Vec<_> = rows.iter().map(|(r, _)| r.series()).collect();
-        s.dedup();
-        s
-    };
-    let columns = plan.columns.max(1);
-    let label_px = 14.0;
-    let mut label_w = 0;
-    for name in &series {
-        label_w = label_w.max(
-            text_size(name, label_px)
-                .map_err(|e| write_error(out, e))?
-                .0,
-        );
-    }
-    let (pad, gap) = (10usize, 4usize);
-    let left = label_w as usize + 2 * pad;
-    let title_h = 54;
-    let legend_h = 64;
-    let grid_w = columns * (cell + gap);
-    let w = (left + grid_w + pad).max(560);
-    let h = title_h + series.len() * (cell + gap) + legend_h;
-    let mut rgb = vec![0u8; w * h * 3];
+    let layout = Layout::new(report, rendered, out)?;
+    let mut rgb = vec![0u8; layout.width * layout.height * 3];
     for px in rgb.chunks_exact_mut(3) {
         px.copy_from_slice(&[LABEL_BACKGROUND.0, LABEL_BACKGROUND.1, LABEL_BACKGROUND.2]);
     }
-    for (row, index) in &rows {
-        let k = series
+    paint_cells(&mut rgb, report, rendered, &layout);
+    paint_colour_bar(&mut rgb, &layout);
+    draw_text(&mut rgb, report, &layout, out)?;
+    write_png(&rgb, layout.size(), out)
+}
+
+/// Text size of the series labels.
+const LABEL_PX: f64 = 14.0;
+/// Space around the sheet's parts, and between its cells.
+const PAD: usize = 10;
+const GAP: usize = 4;
+/// Heights of the title above the cells and of the scale's legend below them.
+const TITLE_H: usize = 54;
+const LEGEND_H: usize = 64;
+
+/// Where the deviation sheet's parts go, in pixels.
+struct Layout {
+    /// The distributions (with their index of refraction), one row each, in report order.
+    series: Vec<String>,
+    cell: usize,
+    columns: usize,
+    /// Width of the label column: where the cells start.
+    left: usize,
+    width: usize,
+    height: usize,
+    /// The colour bar: x, width, y, height.
+    bar: (usize, usize, usize, usize),
+}
+
+impl Layout {
+    fn new(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<Self, Error> {
+        let plan = &rendered.plan;
+        let cell = plan.settings.cell as usize;
+        let mut series: Vec<_> = report.rows.iter().map(|r| r.series()).collect();
+        series.dedup();
+        let columns = plan.columns.max(1);
+        let mut label_w = 0;
+        for name in &series {
+            label_w = label_w.max(
+                text_size(name, LABEL_PX)
+                    .map_err(|e| write_error(out, e))?
+                    .0,
+            );
+        }
+        let left = label_w as usize + 2 * PAD;
+        let width = (left + columns * (cell + GAP) + PAD).max(560);
+        let height = TITLE_H + series.len() * (cell + GAP) + LEGEND_H;
+        let bar = (PAD + 60, width - 2 * PAD - 120, height - LEGEND_H + 10, 14);
+        Ok(Layout {
+            series,
+            cell,
+            columns,
+            left,
+            width,
+            height,
+            bar,
+        })
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width as u32, self.height as u32)
+    }
+
+    /// The top of row `k`.
+    fn row_y(&self, k: usize) -> usize {
+        TITLE_H + k * (self.cell + GAP)
+    }
+}
+
+/// Each report row's corrected sphere in false colour, in its series' row and its
+/// roughness' column.
+fn paint_cells(rgb: &mut [u8], report: &VerifyReport, rendered: &Rendered, layout: &Layout) {
+    let (cell, w) = (layout.cell, layout.width);
+    for row in &report.rows {
+        let index = rendered.plan.rows[row.id].corrected;
+        let k = layout
+            .series
             .iter()
             .position(|name| *name == row.series())
             .expect("listed above");
-        let j = index % columns;
-        let pixels = cell_image(rendered, *index, &row.ring_targets);
-        let (ox, oy) = (left + j * (cell + gap), title_h + k * (cell + gap));
+        let j = index % layout.columns;
+        let pixels = cell_image(rendered, index, &row.ring_targets);
+        let (ox, oy) = (layout.left + j * (cell + GAP), layout.row_y(k));
         for y in 0..cell {
             for x in 0..cell {
                 let at = ((oy + y) * w + ox + x) * 3;
@@ -139,71 +186,81 @@ pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(
             }
         }
     }
-    // The legend's colour bar.
-    let (bar_x, bar_w, bar_y, bar_h) = (pad + 60, w - 2 * pad - 120, h - legend_h + 10, 14);
+}
+
+/// The legend's colour bar, −[`SCALE`] on the left to +[`SCALE`] on the right.
+fn paint_colour_bar(rgb: &mut [u8], layout: &Layout) {
+    let (bar_x, bar_w, bar_y, bar_h) = layout.bar;
     for x in 0..bar_w {
         let d = (2.0 * x as f64 / (bar_w - 1) as f64 - 1.0) * SCALE;
         let c = colour(d);
         for y in 0..bar_h {
-            let at = ((bar_y + y) * w + bar_x + x) * 3;
+            let at = ((bar_y + y) * layout.width + bar_x + x) * 3;
             rgb[at..at + 3].copy_from_slice(&c);
         }
     }
-    {
-        let root = backend(&mut rgb, (w as u32, h as u32), out)?.into_drawing_area();
-        let draw = |text: &str, px: f64, anchor: Pos, at: (usize, usize)| {
-            let style = TextStyle::from((FAMILY, px).into_font())
-                .color(&LABEL_TEXT)
-                .pos(anchor);
-            root.draw_text(text, &style, (at.0 as i32, at.1 as i32))
-                .map_err(|e| write_error(out, format!("cannot draw '{text}': {e}")))
-        };
-        let left_mid = Pos::new(HPos::Left, VPos::Center);
-        let right_mid = Pos::new(HPos::Right, VPos::Center);
-        let centre = Pos::new(HPos::Center, VPos::Top);
-        let info = &report.render;
-        draw(
-            "Corrected spheres: each pixel against what the correction promises",
-            16.0,
-            left_mid,
-            (pad, 16),
-        )?;
-        draw(
-            &format!(
-                "Blender {} · coefficients {} · {} mode, {} colour · {} px, {} spp",
-                info.blender_version,
-                report.coefficients,
-                report.mode.key(),
-                report.color_model.key(),
-                info.cell,
-                info.samples
-            ),
-            12.0,
-            left_mid,
-            (pad, 38),
-        )?;
-        for (k, name) in series.iter().enumerate() {
-            let y = title_h + k * (cell + gap) + cell / 2;
-            draw(name, label_px, right_mid, (left - pad, y))?;
-        }
-        let ticks = [-SCALE, -SCALE / 2.0, 0.0, SCALE / 2.0, SCALE];
-        for t in ticks {
-            let x = bar_x + ((t / SCALE + 1.0) / 2.0 * (bar_w - 1) as f64).round() as usize;
-            let text = if t == 0.0 {
-                "0 (right)".to_string()
-            } else {
-                format!("{:+.1} %", 100.0 * t)
-            };
-            draw(&text, 12.0, centre, (x, bar_y + bar_h + 4))?;
-        }
-        draw("darker", 12.0, right_mid, (bar_x - 6, bar_y + bar_h / 2))?;
-        draw(
-            "brighter",
-            12.0,
-            left_mid,
-            (bar_x + bar_w + 6, bar_y + bar_h / 2),
-        )?;
-        root.present().map_err(|e| write_error(out, e))?;
+}
+
+/// The title, the series labels and the scale's labels.
+fn draw_text(
+    rgb: &mut [u8],
+    report: &VerifyReport,
+    layout: &Layout,
+    out: &Path,
+) -> Result<(), Error> {
+    let root = backend(rgb, layout.size(), out)?.into_drawing_area();
+    let draw = |text: &str, px: f64, anchor: Pos, at: (usize, usize)| {
+        let style = TextStyle::from((FAMILY, px).into_font())
+            .color(&LABEL_TEXT)
+            .pos(anchor);
+        root.draw_text(text, &style, (at.0 as i32, at.1 as i32))
+            .map_err(|e| write_error(out, format!("cannot draw '{text}': {e}")))
+    };
+    let left_mid = Pos::new(HPos::Left, VPos::Center);
+    let right_mid = Pos::new(HPos::Right, VPos::Center);
+    draw(
+        "Corrected spheres: each pixel against what the correction promises",
+        16.0,
+        left_mid,
+        (PAD, 16),
+    )?;
+    draw(&subtitle(report), 12.0, left_mid, (PAD, 38))?;
+    for (k, name) in layout.series.iter().enumerate() {
+        let y = layout.row_y(k) + layout.cell / 2;
+        draw(name, LABEL_PX, right_mid, (layout.left - PAD, y))?;
     }
-    write_png(&rgb, (w as u32, h as u32), out)
+    let (bar_x, bar_w, bar_y, bar_h) = layout.bar;
+    let centre = Pos::new(HPos::Center, VPos::Top);
+    for t in [-SCALE, -SCALE / 2.0, 0.0, SCALE / 2.0, SCALE] {
+        let x = bar_x + ((t / SCALE + 1.0) / 2.0 * (bar_w - 1) as f64).round() as usize;
+        draw(&tick_label(t), 12.0, centre, (x, bar_y + bar_h + 4))?;
+    }
+    draw("darker", 12.0, right_mid, (bar_x - 6, bar_y + bar_h / 2))?;
+    let after_bar = (bar_x + bar_w + 6, bar_y + bar_h / 2);
+    draw("brighter", 12.0, left_mid, after_bar)?;
+    root.present().map_err(|e| write_error(out, e))
+}
+
+/// The line under the title: Blender version, coefficients, mode, colour model, cell size
+/// and samples.
+fn subtitle(report: &VerifyReport) -> String {
+    let info = &report.render;
+    format!(
+        "Blender {} · coefficients {} · {} mode, {} colour · {} px, {} spp",
+        info.blender_version,
+        report.coefficients,
+        report.mode.key(),
+        report.color_model.key(),
+        info.cell,
+        info.samples
+    )
+}
+
+/// A colour bar tick's label: `-5.0 %`, …, `0 (right)`, …, `+5.0 %`.
+fn tick_label(t: f64) -> String {
+    if t == 0.0 {
+        "0 (right)".to_string()
+    } else {
+        format!("{:+.1} %", 100.0 * t)
+    }
 }

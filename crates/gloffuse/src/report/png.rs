@@ -10,6 +10,8 @@ use std::sync::OnceLock;
 
 use image::{ExtendedColorType, ImageEncoder, codecs::png::PngEncoder};
 use plotters::backend::RGBPixel;
+use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -103,6 +105,25 @@ pub fn contact_sheet(
     column_labels: &[String],
     out: &Path,
 ) -> Result<(), Error> {
+    check_sheet_geometry(image, cell, row_labels, column_labels)?;
+    register_font().map_err(|m| write_error(out, m))?;
+    let layout = SheetLayout::new(image, cell, row_labels, column_labels, out)?;
+    let mut rgb = composite_sheet(image, &layout);
+    draw_sheet_labels(&mut rgb, &layout, row_labels, column_labels, out)?;
+    write_png(&rgb, layout.size(), out)
+}
+
+/// The label in the contact sheet's top-left corner, over the row labels.
+const SHEET_CORNER: &str = "roughness";
+
+/// Checks that `image` is a non-empty grid of `cell`-pixel cells with one label per row and
+/// one per column.
+fn check_sheet_geometry(
+    image: &Rgba,
+    cell: usize,
+    row_labels: &[String],
+    column_labels: &[String],
+) -> Result<(), Error> {
     let geometry =
         |value: String, expected: &str| Error::input(Field::ContactSheet, value, expected);
     if cell == 0 || image.width == 0 || image.height == 0 {
@@ -135,32 +156,75 @@ pub fn contact_sheet(
             ),
         ));
     }
-    register_font().map_err(|m| write_error(out, m))?;
+    Ok(())
+}
 
-    // Labels sized to the cell, within readable limits; the header shrinks further if the
-    // roughness values would not fit over their columns.
-    let label_px = (cell as f64 * 0.25).clamp(12.0, 18.0);
-    let pad = (label_px * 0.6).round() as u32;
-    let width_of = |text: &str, px: f64| -> Result<u32, Error> {
-        text_size(text, px)
-            .map(|(w, _)| w)
-            .map_err(|e| write_error(out, e))
-    };
-    let corner = "roughness";
-    let mut label_w = width_of(corner, label_px)?;
-    for l in row_labels {
-        label_w = label_w.max(width_of(l, label_px)?);
-    }
-    let mut widest_column = 1;
-    for l in column_labels {
-        widest_column = widest_column.max(width_of(l, label_px)?);
-    }
-    let header_px =
-        (label_px * (cell as f64 - 4.0).max(1.0) / widest_column as f64).clamp(8.0, label_px);
-    let left = (label_w + 2 * pad) as usize;
-    let top = (label_px * 1.5).round() as usize + pad as usize;
-    let (w, h) = (left + image.width, top + image.height);
+/// Where the contact sheet's labels and grid go, in pixels.
+struct SheetLayout {
+    cell: usize,
+    /// Text size of the row labels and the corner.
+    label_px: f64,
+    /// Text size of the column labels.
+    header_px: f64,
+    pad: u32,
+    /// The grid's top-left corner: the label column's width and the header's height.
+    left: usize,
+    top: usize,
+    width: usize,
+    height: usize,
+}
 
+impl SheetLayout {
+    /// Labels sized to the cell, within readable limits; the header shrinks further if the
+    /// roughness values would not fit over their columns.
+    fn new(
+        image: &Rgba,
+        cell: usize,
+        row_labels: &[String],
+        column_labels: &[String],
+        out: &Path,
+    ) -> Result<Self, Error> {
+        let label_px = (cell as f64 * 0.25).clamp(12.0, 18.0);
+        let pad = (label_px * 0.6).round() as u32;
+        let width_of = |text: &str| -> Result<u32, Error> {
+            text_size(text, label_px)
+                .map(|(w, _)| w)
+                .map_err(|e| write_error(out, e))
+        };
+        let mut label_w = width_of(SHEET_CORNER)?;
+        for l in row_labels {
+            label_w = label_w.max(width_of(l)?);
+        }
+        let mut widest_column = 1;
+        for l in column_labels {
+            widest_column = widest_column.max(width_of(l)?);
+        }
+        let header_px =
+            (label_px * (cell as f64 - 4.0).max(1.0) / widest_column as f64).clamp(8.0, label_px);
+        let left = (label_w + 2 * pad) as usize;
+        let top = (label_px * 1.5).round() as usize + pad as usize;
+        Ok(SheetLayout {
+            cell,
+            label_px,
+            header_px,
+            pad,
+            left,
+            top,
+            width: left + image.width,
+            height: top + image.height,
+        })
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width as u32, self.height as u32)
+    }
+}
+
+/// The sheet's RGB bytes before the labels: label background, with the grid composited
+/// over [`BACKGROUND`] and sRGB-encoded in its place.
+fn composite_sheet(image: &Rgba, layout: &SheetLayout) -> Vec<u8> {
+    let (w, h) = (layout.width, layout.height);
+    let (left, top) = (layout.left, layout.top);
     let mut rgb = vec![0u8; w * h * 3];
     for (i, px) in rgb.chunks_exact_mut(3).enumerate() {
         px.copy_from_slice(&[LABEL_BACKGROUND.0, LABEL_BACKGROUND.1, LABEL_BACKGROUND.2]);
@@ -171,36 +235,41 @@ pub fn contact_sheet(
             px.copy_from_slice(&[srgb8(r + under), srgb8(g + under), srgb8(b + under)]);
         }
     }
+    rgb
+}
 
-    {
-        let root = backend(&mut rgb, (w as u32, h as u32), out)?.into_drawing_area();
-        let draw = |text: &str, px: f64, anchor: Pos, at: (i32, i32)| {
-            let style = TextStyle::from((FAMILY, px).into_font())
-                .color(&LABEL_TEXT)
-                .pos(anchor);
-            root.draw_text(text, &style, at)
-                .map_err(|e| write_error(out, format!("cannot draw the label '{text}': {e}")))
-        };
-        let right = Pos::new(HPos::Right, VPos::Center);
-        let centre = Pos::new(HPos::Center, VPos::Center);
-        let header_y = (top / 2) as i32;
-        draw(
-            corner,
-            label_px,
-            right,
-            (left as i32 - pad as i32, header_y),
-        )?;
-        for (j, l) in column_labels.iter().enumerate() {
-            let x = left + j * cell + cell / 2;
-            draw(l, header_px, centre, (x as i32, header_y))?;
-        }
-        for (i, l) in row_labels.iter().enumerate() {
-            let y = top + i * cell + cell / 2;
-            draw(l, label_px, right, (left as i32 - pad as i32, y as i32))?;
-        }
-        root.present().map_err(|e| write_error(out, e))?;
+/// Draws the corner label, the column labels over their columns and the row labels beside
+/// their rows onto the sheet's bytes.
+fn draw_sheet_labels(
+    rgb: &mut [u8],
+    layout: &SheetLayout,
+    row_labels: &[String],
+    column_labels: &[String],
+    out: &Path,
+) -> Result<(), Error> {
+    let root = backend(rgb, layout.size(), out)?.into_drawing_area();
+    let draw = |text: &str, px: f64, anchor: Pos, at: (i32, i32)| {
+        let style = TextStyle::from((FAMILY, px).into_font())
+            .color(&LABEL_TEXT)
+            .pos(anchor);
+        root.draw_text(text, &style, at)
+            .map_err(|e| write_error(out, format!("cannot draw the label '{text}': {e}")))
+    };
+    let right = Pos::new(HPos::Right, VPos::Center);
+    let centre = Pos::new(HPos::Center, VPos::Center);
+    let (left, top, cell) = (layout.left, layout.top, layout.cell);
+    let label_x = left as i32 - layout.pad as i32;
+    let header_y = (top / 2) as i32;
+    draw(SHEET_CORNER, layout.label_px, right, (label_x, header_y))?;
+    for (j, l) in column_labels.iter().enumerate() {
+        let x = left + j * cell + cell / 2;
+        draw(l, layout.header_px, centre, (x as i32, header_y))?;
     }
-    write_png(&rgb, (w as u32, h as u32), out)
+    for (i, l) in row_labels.iter().enumerate() {
+        let y = top + i * cell + cell / 2;
+        draw(l, layout.label_px, right, (label_x, y as i32))?;
+    }
+    root.present().map_err(|e| write_error(out, e))
 }
 
 /// Colours of one distribution's series in the plot.
@@ -234,78 +303,151 @@ fn percent_points(points: impl Iterator<Item = (f64, f64)>) -> Points {
 /// coefficients. [`PLOT_SIZE`] pixels, written as PNG atomically. NaN values are left out.
 pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
     register_font().map_err(|m| write_error(out, m))?;
-    let fail = |e: &dyn Display| write_error(out, format!("cannot draw the plot: {e}"));
+    let plot = PlotData::of(report);
+    let (w, h) = PLOT_SIZE;
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = backend(&mut rgb, (w, h), out)?.into_drawing_area();
+        draw_plot(&root, &plot)
+            .map_err(|e| write_error(out, format!("cannot draw the plot: {e}")))?;
+    }
+    write_png(&rgb, (w, h), out)
+}
 
-    // Layered sweeps plot one index of refraction (glass, 1.5, when it was rendered): the
-    // table, report.json and the zoomed panel below hold every index.
-    let plotted_ior = report.rows.iter().find_map(|r| r.ior).map(|first| {
+/// What the brightness plot shows, gathered from a report before anything is drawn.
+struct PlotData {
+    mode: Mode,
+    title: String,
+    /// Per distribution: uncorrected, its prediction, corrected, its prediction.
+    series: Vec<(Distribution, [Points; 4])>,
+    reference: Points,
+    /// Per distribution: the corrected spheres' deviation (%), for the zoomed panel.
+    zoom: Vec<(Distribution, Points)>,
+    /// The pass band's half width in %, 0 when there is none.
+    tolerance: f64,
+    x: (f64, f64),
+    y: (f64, f64),
+    /// The zoomed panel's y axis runs from −zoom_half to zoom_half.
+    zoom_half: f64,
+}
+
+impl PlotData {
+    fn of(report: &VerifyReport) -> Self {
+        let plotted_ior = plotted_ior(report);
+        let mut distributions: Vec<Distribution> = Vec::new();
+        for row in &report.rows {
+            if !distributions.contains(&row.distribution) {
+                distributions.push(row.distribution);
+            }
+        }
+        let series: Vec<_> = distributions
+            .iter()
+            .map(|&d| (d, series_points(report, d, plotted_ior)))
+            .collect();
+        let reference = percent_points(
+            report
+                .reference
+                .iter()
+                .filter(|s| s.ior == plotted_ior)
+                .map(|s| (s.roughness.get(), s.brightness)),
+        );
+        let tolerance = if report.tolerance_percent.is_finite() {
+            report.tolerance_percent.abs()
+        } else {
+            0.0
+        };
+        let zoom: Vec<_> = distributions
+            .iter()
+            .map(|&d| (d, zoom_points(report, d)))
+            .collect();
+        let zoom_half = zoom
+            .iter()
+            .flat_map(|(_, p)| p.iter().map(|(_, y)| y.abs() * 1.25))
+            .fold((3.0 * tolerance).max(0.5), f64::max);
+        let (x, y) = plot_ranges(&series, &reference, tolerance);
+        PlotData {
+            mode: report.mode,
+            title: plot_title(report, plotted_ior),
+            series,
+            reference,
+            zoom,
+            tolerance,
+            x,
+            y,
+            zoom_half,
+        }
+    }
+}
+
+/// Layered sweeps plot one index of refraction (glass, 1.5, when it was rendered): the
+/// table, report.json and the zoomed panel hold every index.
+fn plotted_ior(report: &VerifyReport) -> Option<f64> {
+    report.rows.iter().find_map(|r| r.ior).map(|first| {
         if report.rows.iter().any(|r| r.ior == Some(1.5)) {
             1.5
         } else {
             first
         }
-    });
-    let mut distributions: Vec<Distribution> = Vec::new();
-    for row in &report.rows {
-        if !distributions.contains(&row.distribution) {
-            distributions.push(row.distribution);
-        }
-    }
-    let series: Vec<(Distribution, [Points; 4])> = distributions
-        .iter()
-        .map(|&d| {
-            let rows = || {
-                report
-                    .rows
-                    .iter()
-                    .filter(move |r| r.distribution == d && r.ior == plotted_ior)
-            };
-            let pts = |f: fn(&crate::verify::Row) -> f64| {
-                percent_points(rows().map(|r| (r.roughness.get(), f(r))))
-            };
-            (
-                d,
-                [
-                    pts(|r| r.uncorrected_brightness),
-                    pts(|r| r.predicted_uncorrected),
-                    pts(|r| r.brightness),
-                    pts(|r| r.predicted_corrected),
-                ],
-            )
-        })
-        .collect();
-    let reference = percent_points(
-        report
-            .reference
-            .iter()
-            .filter(|s| s.ior == plotted_ior)
-            .map(|s| (s.roughness.get(), s.brightness)),
-    );
+    })
+}
 
-    let tolerance = if report.tolerance_percent.is_finite() {
-        report.tolerance_percent.abs()
-    } else {
-        0.0
+/// Distribution `d`'s points at index `ior`: uncorrected, its prediction, corrected, its
+/// prediction.
+fn series_points(report: &VerifyReport, d: Distribution, ior: Option<f64>) -> [Points; 4] {
+    let pts = |f: fn(&crate::verify::Row) -> f64| {
+        percent_points(
+            report
+                .rows
+                .iter()
+                .filter(|r| r.distribution == d && r.ior == ior)
+                .map(|r| (r.roughness.get(), f(r))),
+        )
     };
-    let all = || {
-        series
-            .iter()
-            .flat_map(|(_, s)| s.iter().flatten())
-            .chain(reference.iter())
-    };
+    [
+        pts(|r| r.uncorrected_brightness),
+        pts(|r| r.predicted_uncorrected),
+        pts(|r| r.brightness),
+        pts(|r| r.predicted_corrected),
+    ]
+}
+
+/// The zoomed panel's points of distribution `d`: corrected spheres' distance from what
+/// they promise, in %, at every index of refraction.
+fn zoom_points(report: &VerifyReport, d: Distribution) -> Points {
+    let rows = report.rows.iter().filter(|r| r.distribution == d);
+    let mut points: Points = rows
+        .map(|r| (r.roughness.get(), 100.0 * (r.brightness - 1.0)))
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    points
+}
+
+/// The main panel's x and y ranges: every point and the pass band, y in whole multiples of
+/// 5 % with some air and at least 20 % tall.
+fn plot_ranges(
+    series: &[(Distribution, [Points; 4])],
+    reference: &Points,
+    tolerance: f64,
+) -> ((f64, f64), (f64, f64)) {
+    let all = series
+        .iter()
+        .flat_map(|(_, s)| s.iter().flatten())
+        .chain(reference.iter());
     let (mut y_lo, mut y_hi) = (100.0 - tolerance, 100.0 + tolerance);
     let (mut x_lo, mut x_hi) = (0.0f64, 1.0f64);
-    for &(x, y) in all() {
+    for &(x, y) in all {
         (x_lo, x_hi) = (x_lo.min(x), x_hi.max(x));
         (y_lo, y_hi) = (y_lo.min(y), y_hi.max(y));
     }
-    // Whole multiples of 5 % with some air, at least 20 % tall.
     let y_lo = ((y_lo - 2.0) / 5.0).floor() * 5.0;
     let y_hi = (((y_hi + 2.0) / 5.0).ceil() * 5.0).max(y_lo + 20.0);
     let x_pad = 0.02 * (x_hi - x_lo);
-    let (x_lo, x_hi) = (x_lo - x_pad, x_hi + x_pad);
+    ((x_lo - x_pad, x_hi + x_pad), (y_lo, y_hi))
+}
 
-    let title = match plotted_ior {
+fn plot_title(report: &VerifyReport, plotted_ior: Option<f64>) -> String {
+    match plotted_ior {
         Some(n) => format!(
             "Layered furnace brightness · Blender {} · IOR {n} · {} spp",
             report.render.blender_version, report.render.samples
@@ -316,201 +458,206 @@ pub fn brightness_plot(report: &VerifyReport, out: &Path) -> Result<(), Error> {
             shorten(&report.coefficients, 36),
             report.render.samples
         ),
-    };
-    let (uncorrected_name, corrected_name) = match report.mode {
+    }
+}
+
+/// The plot's two panels: brightness against roughness with its axes and the legend panel
+/// beside it; the corrected spheres zoomed below.
+fn draw_plot<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    plot: &PlotData,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (w, h) = PLOT_SIZE;
+    root.fill(&WHITE)?;
+    let below_title = root.titled(&plot.title, (FAMILY, 20))?;
+    let (left_area, legend_area) = below_title.split_horizontally(w as i32 - LEGEND_WIDTH);
+    let (plot_area, zoom_area) = left_area.split_vertically((h as f64 * 0.64) as i32);
+    let legend = draw_brightness_panel(&plot_area, plot)?;
+    draw_legend(&legend_area, &legend)?;
+    draw_zoom_panel(&zoom_area, plot)?;
+    root.present()
+}
+
+/// A panel of the plot: roughness across, f64 both ways.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type Drawn<T, DB> = Result<T, DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// The main panel: the pass band, every distribution's series, the reference and the 100 %
+/// line; returns the legend of what it drew.
+fn draw_brightness_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &PlotData,
+) -> Drawn<Vec<Legend>, DB> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(60)
+        .build_cartesian_2d(plot.x.0..plot.x.1, plot.y.0..plot.y.1)?;
+    draw_mesh(&mut chart, "brightness (%)", 12, &|y| format!("{y:.0}"))?;
+    let tolerance = plot.tolerance;
+    if tolerance > 0.0 {
+        draw_band(&mut chart, plot.x, (100.0 - tolerance, 100.0 + tolerance))?;
+    }
+    let mut legend = Vec::new();
+    for (d, points) in &plot.series {
+        legend.extend(draw_distribution(&mut chart, *d, points, plot.mode)?);
+    }
+    if !plot.reference.is_empty() {
+        legend.extend(draw_reference(&mut chart, &plot.reference, plot.mode)?);
+    }
+    // On top, so it shows through curves that lie on it.
+    draw_level(&mut chart, plot.x, 100.0)?;
+    legend.push(Legend::Heading("Target".into(), BLACK));
+    legend.push(Legend::Entry(Key::Dashed(BLACK.into(), 1), "100 %".into()));
+    if tolerance > 0.0 {
+        legend.push(Legend::Entry(
+            Key::Band(PASS_BAND.mix(0.12)),
+            format!("100 % ± {tolerance} % (pass)"),
+        ));
+    }
+    Ok(legend)
+}
+
+/// The zoomed panel: each distribution's corrected spheres against 0 and the pass band.
+fn draw_zoom_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &PlotData,
+) -> Drawn<(), DB> {
+    let half = plot.zoom_half;
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .caption(
+            "corrected, zoomed: distance from what the correction promises",
+            (FAMILY, 14),
+        )
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(plot.x.0..plot.x.1, -half..half)?;
+    draw_mesh(&mut chart, "deviation (%)", 9, &|y| format!("{y:+.1}"))?;
+    if plot.tolerance > 0.0 {
+        draw_band(&mut chart, plot.x, (-plot.tolerance, plot.tolerance))?;
+    }
+    draw_level(&mut chart, plot.x, 0.0)?;
+    for (d, points) in &plot.zoom {
+        let c = colour(*d);
+        chart.draw_series(LineSeries::new(points.iter().copied(), c.stroke_width(1)))?;
+        chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+    }
+    Ok(())
+}
+
+/// A panel's grid and axes: roughness across, `y_desc` up with `y_labels` labels.
+fn draw_mesh<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    y_desc: &str,
+    y_labels: usize,
+    y_format: &dyn Fn(&f64) -> String,
+) -> Drawn<(), DB> {
+    chart
+        .configure_mesh()
+        .x_desc("roughness")
+        .y_desc(y_desc)
+        .axis_desc_style((FAMILY, 15))
+        .label_style((FAMILY, 13))
+        .x_labels(11)
+        .y_labels(y_labels)
+        .x_label_formatter(&|x| format!("{x:.1}"))
+        .y_label_formatter(y_format)
+        .light_line_style(RGBColor(242, 242, 242))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .draw()
+}
+
+/// The pass band from `y.0` to `y.1` across the panel.
+fn draw_band<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    (x_lo, x_hi): (f64, f64),
+    (y_lo, y_hi): (f64, f64),
+) -> Drawn<(), DB> {
+    chart.draw_series([Rectangle::new(
+        [(x_lo, y_lo), (x_hi, y_hi)],
+        PASS_BAND.mix(0.12).filled(),
+    )])?;
+    Ok(())
+}
+
+/// A dashed black line at `y` across the panel.
+fn draw_level<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    (x_lo, x_hi): (f64, f64),
+    y: f64,
+) -> Drawn<(), DB> {
+    chart.draw_series(DashedLineSeries::new(
+        [(x_lo, y), (x_hi, y)],
+        8,
+        5,
+        BLACK.stroke_width(1),
+    ))?;
+    Ok(())
+}
+
+/// One distribution's predictions (lines) and rendered means (circles), with their legend.
+fn draw_distribution<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    d: Distribution,
+    [uncorrected, predicted_u, corrected, predicted_c]: &[Points; 4],
+    mode: Mode,
+) -> Drawn<[Legend; 5], DB> {
+    let c = colour(d);
+    chart.draw_series(DashedLineSeries::new(
+        predicted_u.iter().copied(),
+        6,
+        4,
+        c.mix(0.6).stroke_width(2),
+    ))?;
+    chart.draw_series(LineSeries::new(
+        predicted_c.iter().copied(),
+        c.stroke_width(2),
+    ))?;
+    chart.draw_series(
+        uncorrected
+            .iter()
+            .map(|&p| Circle::new(p, 4, c.stroke_width(2))),
+    )?;
+    chart.draw_series(corrected.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
+    let (uncorrected_name, corrected_name) = match mode {
         Mode::Layered => ("Mix Shader", "layered"),
         _ => ("uncorrected", "corrected"),
     };
-    // The zoomed panel: corrected spheres' distance from what they promise.
-    let zoom: Vec<(Distribution, Points)> = distributions
-        .iter()
-        .map(|&d| {
-            let rows = report.rows.iter().filter(|r| r.distribution == d);
-            let mut points: Points = rows
-                .map(|r| (r.roughness.get(), 100.0 * (r.brightness - 1.0)))
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .collect();
-            points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            (d, points)
-        })
-        .collect();
-    let zoom_half = zoom
-        .iter()
-        .flat_map(|(_, p)| p.iter().map(|(_, y)| y.abs() * 1.25))
-        .fold((3.0 * tolerance).max(0.5), f64::max);
-    let (w, h) = PLOT_SIZE;
-    let mut rgb = vec![255u8; (w * h * 3) as usize];
-    {
-        let root = backend(&mut rgb, (w, h), out)?.into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let below_title = root.titled(&title, (FAMILY, 20)).map_err(|e| fail(&e))?;
-        let (left_area, legend_area) = below_title.split_horizontally(w as i32 - LEGEND_WIDTH);
-        let (plot_area, zoom_area) = left_area.split_vertically((h as f64 * 0.64) as i32);
-        let mut chart = ChartBuilder::on(&plot_area)
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("roughness")
-            .y_desc("brightness (%)")
-            .axis_desc_style((FAMILY, 15))
-            .label_style((FAMILY, 13))
-            .x_labels(11)
-            .y_labels(12)
-            .x_label_formatter(&|x| format!("{x:.1}"))
-            .y_label_formatter(&|y| format!("{y:.0}"))
-            .light_line_style(RGBColor(242, 242, 242))
-            .bold_line_style(RGBColor(215, 215, 215))
-            .draw()
-            .map_err(|e| fail(&e))?;
+    Ok([
+        Legend::Heading(d.label().to_string(), c),
+        Legend::Entry(Key::Hollow(c), format!("{uncorrected_name}, rendered")),
+        Legend::Entry(
+            Key::Dashed(c.mix(0.6), 2),
+            format!("{uncorrected_name}, predicted"),
+        ),
+        Legend::Entry(Key::Filled(c), format!("{corrected_name}, rendered")),
+        Legend::Entry(Key::Solid(c.into()), format!("{corrected_name}, predicted")),
+    ])
+}
 
-        let mut legend = Vec::new();
-        if tolerance > 0.0 {
-            chart
-                .draw_series([Rectangle::new(
-                    [(x_lo, 100.0 - tolerance), (x_hi, 100.0 + tolerance)],
-                    PASS_BAND.mix(0.12).filled(),
-                )])
-                .map_err(|e| fail(&e))?;
-        }
-        for (d, [uncorrected, predicted_u, corrected, predicted_c]) in &series {
-            let c = colour(*d);
-            chart
-                .draw_series(DashedLineSeries::new(
-                    predicted_u.iter().copied(),
-                    6,
-                    4,
-                    c.mix(0.6).stroke_width(2),
-                ))
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(LineSeries::new(
-                    predicted_c.iter().copied(),
-                    c.stroke_width(2),
-                ))
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(
-                    uncorrected
-                        .iter()
-                        .map(|&p| Circle::new(p, 4, c.stroke_width(2))),
-                )
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(corrected.iter().map(|&p| Circle::new(p, 4, c.filled())))
-                .map_err(|e| fail(&e))?;
-            legend.push(Legend::Heading(d.label().to_string(), c));
-            legend.push(Legend::Entry(
-                Key::Hollow(c),
-                format!("{uncorrected_name}, rendered"),
-            ));
-            legend.push(Legend::Entry(
-                Key::Dashed(c.mix(0.6), 2),
-                format!("{uncorrected_name}, predicted"),
-            ));
-            legend.push(Legend::Entry(
-                Key::Filled(c),
-                format!("{corrected_name}, rendered"),
-            ));
-            legend.push(Legend::Entry(
-                Key::Solid(c.into()),
-                format!("{corrected_name}, predicted"),
-            ));
-        }
-        if !reference.is_empty() {
-            chart
-                .draw_series(LineSeries::new(
-                    reference.iter().copied(),
-                    REFERENCE_COLOUR.stroke_width(1),
-                ))
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(
-                    reference
-                        .iter()
-                        .map(|&p| TriangleMarker::new(p, 5, REFERENCE_COLOUR.filled())),
-                )
-                .map_err(|e| fail(&e))?;
-            legend.push(Legend::Heading("Reference".into(), REFERENCE_COLOUR));
-            legend.push(Legend::Entry(
-                Key::Triangle(REFERENCE_COLOUR),
-                reference_label(report.mode).into(),
-            ));
-        }
-        // On top, so it shows through curves that lie on it.
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_lo, 100.0), (x_hi, 100.0)],
-                8,
-                5,
-                BLACK.stroke_width(1),
-            ))
-            .map_err(|e| fail(&e))?;
-        legend.push(Legend::Heading("Target".into(), BLACK));
-        legend.push(Legend::Entry(Key::Dashed(BLACK.into(), 1), "100 %".into()));
-        if tolerance > 0.0 {
-            legend.push(Legend::Entry(
-                Key::Band(PASS_BAND.mix(0.12)),
-                format!("100 % ± {tolerance} % (pass)"),
-            ));
-        }
-        draw_legend(&legend_area, &legend).map_err(|e| fail(&e))?;
-
-        let mut chart = ChartBuilder::on(&zoom_area)
-            .margin(12)
-            .caption(
-                "corrected, zoomed: distance from what the correction promises",
-                (FAMILY, 14),
-            )
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x_lo..x_hi, -zoom_half..zoom_half)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("roughness")
-            .y_desc("deviation (%)")
-            .axis_desc_style((FAMILY, 15))
-            .label_style((FAMILY, 13))
-            .x_labels(11)
-            .y_labels(9)
-            .x_label_formatter(&|x| format!("{x:.1}"))
-            .y_label_formatter(&|y| format!("{y:+.1}"))
-            .light_line_style(RGBColor(242, 242, 242))
-            .bold_line_style(RGBColor(215, 215, 215))
-            .draw()
-            .map_err(|e| fail(&e))?;
-        if tolerance > 0.0 {
-            chart
-                .draw_series([Rectangle::new(
-                    [(x_lo, -tolerance), (x_hi, tolerance)],
-                    PASS_BAND.mix(0.12).filled(),
-                )])
-                .map_err(|e| fail(&e))?;
-        }
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x_lo, 0.0), (x_hi, 0.0)],
-                8,
-                5,
-                BLACK.stroke_width(1),
-            ))
-            .map_err(|e| fail(&e))?;
-        for (d, points) in &zoom {
-            let c = colour(*d);
-            chart
-                .draw_series(LineSeries::new(points.iter().copied(), c.stroke_width(1)))
-                .map_err(|e| fail(&e))?;
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 4, c.filled())))
-                .map_err(|e| fail(&e))?;
-        }
-        root.present().map_err(|e| fail(&e))?;
-    }
-    write_png(&rgb, (w, h), out)
+/// The reference's line and triangles, with their legend.
+fn draw_reference<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    reference: &Points,
+    mode: Mode,
+) -> Drawn<[Legend; 2], DB> {
+    chart.draw_series(LineSeries::new(
+        reference.iter().copied(),
+        REFERENCE_COLOUR.stroke_width(1),
+    ))?;
+    chart.draw_series(
+        reference
+            .iter()
+            .map(|&p| TriangleMarker::new(p, 5, REFERENCE_COLOUR.filled())),
+    )?;
+    Ok([
+        Legend::Heading("Reference".into(), REFERENCE_COLOUR),
+        Legend::Entry(
+            Key::Triangle(REFERENCE_COLOUR),
+            reference_label(mode).into(),
+        ),
+    ])
 }
 
 /// Width of the legend panel to the right of the plot.
@@ -535,7 +682,7 @@ enum Key {
 
 /// The legend as a column of headed groups in its own panel, so it never hides a point.
 fn draw_legend<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
+    area: &DrawingArea<DB, Shift>,
     items: &[Legend],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let line = 19;
