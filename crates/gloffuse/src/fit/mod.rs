@@ -197,7 +197,7 @@ impl FitSummary {
                     d: c(0),
                     degree: e.degree,
                     distribution,
-                    residuals: e.residuals.clone(),
+                    residuals: e.residuals,
                     weighting: e.weighting,
                 }
             })
