@@ -12,6 +12,7 @@ use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{AlbedoIntegrator, Distribution, Engine, Roughness};
 use crate::output::check_destination;
 use crate::progress::Progress;
+use crate::verify::stats::SphereStats;
 use crate::verify::{
     Judging, Plan, RenderSettings, Rendered, Role, VerifyOptions, VerifyReport, render, verify_with,
 };
@@ -101,8 +102,39 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
     check_destination(&a.out)?;
     let engine = a.render.engine;
     let blender = a.blender.find(progress)?;
-    let rs = grid();
-    let plan = Plan::measure(&Distribution::ALL, &rs, a.render);
+    let plan = Plan::measure(&Distribution::ALL, &grid(), a.render);
+    let stats = render_plain(&blender, &plan, a, progress)?;
+    // EEVEE Next's world lighting is 0.8 % dark for every material: the curve corrects the
+    // BSDF's loss, measured against a white Diffuse sphere in the same image.
+    let lighting = plan.lighting().map(|cell| stats[cell].mean);
+    let (measurements, warnings) = compare(&blender, &plan, &stats, engine, lighting);
+    let coefficients = fit_measured(&blender, a, lighting, &measurements)?;
+    coefficients.write(&a.out)?;
+
+    let verify = if a.verify {
+        Some(verify_new(&blender, a, progress)?)
+    } else {
+        None
+    };
+    Ok(Refreshed {
+        blender_version: blender.version_string.clone(),
+        engine,
+        lighting,
+        out: a.out.display().to_string(),
+        measurements,
+        warnings,
+        coefficients,
+        verify,
+    })
+}
+
+/// Renders the plain spheres of `plan` and returns their statistics, in plan order.
+fn render_plain(
+    blender: &Blender,
+    plan: &Plan,
+    a: &RefreshOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<SphereStats>, Error> {
     // Plain spheres need no groups; the furnace script still builds them from a preset.
     let groups = GenerateParams::new(
         Curves::Presets(&[Engine::Cycles]),
@@ -111,24 +143,33 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
         ColorModel::Exact,
     )?;
     let Rendered { stats, .. } = render(
-        &blender,
-        &plan,
+        blender,
+        plan,
         &groups,
         Mode::Roughness,
         [1.0; 3],
         &a.blender,
         progress,
     )?;
+    Ok(stats)
+}
 
+/// Each uncorrected sphere's mean (divided by `lighting`, if any) beside what the
+/// integrator predicts for it, and a warning for each that disagrees by more than
+/// [`DISAGREEMENT`].
+fn compare(
+    blender: &Blender,
+    plan: &Plan,
+    stats: &[SphereStats],
+    engine: Engine,
+    lighting: Option<f64>,
+) -> (Vec<Measurement>, Vec<String>) {
     let integrator = AlbedoIntegrator::default();
     let masking = blender.version.masking();
-    // EEVEE Next's world lighting is 0.8 % dark for every material: the curve corrects the
-    // BSDF's loss, measured against a white Diffuse sphere in the same image.
-    let lighting = plan.lighting().map(|cell| stats[cell].mean);
     let scale = 1.0 / lighting.unwrap_or(1.0);
     let mut measurements = Vec::new();
     let mut warnings = Vec::new();
-    for (cell, s) in plan.cells.iter().zip(&stats) {
+    for (cell, s) in plan.cells.iter().zip(stats) {
         let Role::Uncorrected(d) = cell.role else {
             continue;
         };
@@ -153,13 +194,49 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
             predicted,
         });
     }
+    (measurements, warnings)
+}
 
-    let spec = FitSpec {
+/// The coefficients fitted to `measurements`, named and described for where they were
+/// measured.
+fn fit_measured(
+    blender: &Blender,
+    a: &RefreshOptions,
+    lighting: Option<f64>,
+    measurements: &[Measurement],
+) -> Result<Coefficients, Error> {
+    let engine = a.render.engine;
+    let points = Distribution::ALL.map(|d| {
+        let points = measurements
+            .iter()
+            .filter(|m| m.distribution == d)
+            .map(|m| Point {
+                roughness: m.roughness.get(),
+                percent: 100.0 * m.measured,
+            })
+            .collect();
+        (d, points)
+    });
+    Coefficients::fit(
+        format!("measured in {engine}, Blender {}", blender.version_string),
+        format!(
+            "Mean brightness of white glossy furnace spheres rendered in {engine}, Blender {} ({} spp, {} px), fitted by gloffuse refresh; gain = 100 / f(r).",
+            blender.version_string, a.render.samples, a.render.cell
+        ),
+        &fit_spec(blender, a, lighting),
+        points,
+    )
+}
+
+/// How the measurements are fitted, and where they come from.
+fn fit_spec(blender: &Blender, a: &RefreshOptions, lighting: Option<f64>) -> FitSpec {
+    let engine = a.render.engine;
+    FitSpec {
         degree: a.degree,
         weighting: Weighting::Relative,
         target: Target::Mean,
         // The masking of the BSDF the engine renders.
-        masking: engine.masking(masking),
+        masking: engine.masking(blender.version.masking()),
         engine,
         provenance: Provenance {
             source: Source::Blender,
@@ -176,44 +253,7 @@ pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed,
                 ),
             }),
         },
-    };
-    let points = Distribution::ALL.map(|d| {
-        let points = measurements
-            .iter()
-            .filter(|m| m.distribution == d)
-            .map(|m| Point {
-                roughness: m.roughness.get(),
-                percent: 100.0 * m.measured,
-            })
-            .collect();
-        (d, points)
-    });
-    let coefficients = Coefficients::fit(
-        format!("measured in {engine}, Blender {}", blender.version_string),
-        format!(
-            "Mean brightness of white glossy furnace spheres rendered in {engine}, Blender {} ({} spp, {} px), fitted by gloffuse refresh; gain = 100 / f(r).",
-            blender.version_string, a.render.samples, a.render.cell
-        ),
-        &spec,
-        points,
-    )?;
-    coefficients.write(&a.out)?;
-
-    let verify = if a.verify {
-        Some(verify_new(&blender, a, progress)?)
-    } else {
-        None
-    };
-    Ok(Refreshed {
-        blender_version: blender.version_string.clone(),
-        engine,
-        lighting,
-        out: a.out.display().to_string(),
-        measurements,
-        warnings,
-        coefficients,
-        verify,
-    })
+    }
 }
 
 /// The verify sweep with the new file, at verify's own defaults and the measurement's

@@ -214,95 +214,133 @@ fn package_module(from: &str) -> Option<&str> {
         .or_else(|| from.strip_prefix(PACKAGE).and_then(|m| m.strip_prefix('.')))
 }
 
-fn parse(module: &str, source: &str) -> Result<Parsed, BundleError> {
-    let unsupported = |line: &str| BundleError::Unsupported {
+fn unsupported(module: &str, line: &str) -> BundleError {
+    BundleError::Unsupported {
         module: module.to_string(),
         line: line.trim_end().to_string(),
-    };
+    }
+}
+
+fn parse(module: &str, source: &str) -> Result<Parsed, BundleError> {
     let mut parsed = Parsed::default();
     let mut in_string: Option<&str> = None;
     let mut lines = source.split_inclusive('\n');
     while let Some(line) = lines.next() {
         let top_level = in_string.is_none();
-        for quote in ["\"\"\"", "'''"] {
-            if in_string.is_none_or(|q| q == quote) && line.matches(quote).count() % 2 == 1 {
-                in_string = if in_string.is_some() {
-                    None
-                } else {
-                    Some(quote)
-                };
-            }
-        }
+        in_string = string_after(in_string, line);
         if !top_level {
             parsed.push(line);
-            continue;
-        }
-        if let Some(rest) = line.strip_prefix("from ") {
-            let (from, names) = rest
-                .split_once(" import ")
-                .ok_or_else(|| unsupported(line))?;
-            let from = from.trim();
-            let mut statement = line.to_string();
-            let mut names = names.to_string();
-            if names.trim_start().starts_with('(') {
-                while !names.contains(')') {
-                    let next = lines.next().ok_or_else(|| unsupported(&statement))?;
-                    statement.push_str(next);
-                    names.push_str(next);
-                }
-            }
-            let names: Vec<String> = names
-                .lines()
-                .map(|l| l.split('#').next().unwrap_or(""))
-                .flat_map(|l| l.split(','))
-                .map(|n| n.trim().trim_matches(|c| c == '(' || c == ')').trim())
-                .filter(|n| !n.is_empty())
-                .map(str::to_string)
-                .collect();
-            if from == "." || from == PACKAGE {
-                return Err(unsupported(&statement));
-            }
-            match package_module(from) {
-                Some(target) if is_identifier(target) && names.iter().all(|n| is_identifier(n)) => {
-                    parsed.imports.push((target.to_string(), names));
-                }
-                Some(_) => return Err(unsupported(&statement)),
-                None if from.starts_with('.') => return Err(unsupported(&statement)),
-                None => {
-                    // `from os import path as p` binds p.
-                    let bound = names.iter().map(|n| match n.split_once(" as ") {
-                        Some((_, alias)) => alias.trim().to_string(),
-                        None => n.clone(),
-                    });
-                    parsed.imported.extend(bound);
-                    parsed.push_import(&statement);
-                }
-            }
-            continue;
-        }
-        if let Some(rest) = line.strip_prefix("import ") {
-            for item in rest.split('#').next().unwrap_or("").split(',') {
-                let item = item.trim();
-                if item == PACKAGE || item.starts_with(&format!("{PACKAGE}.")) {
-                    return Err(unsupported(line));
-                }
-                let bound = match item.split_once(" as ") {
-                    Some((_, alias)) => alias.trim(),
-                    None => item.split('.').next().unwrap_or(item),
-                };
-                parsed.imported.insert(bound.to_string());
-            }
-            parsed.push_import(line);
-            continue;
+        } else if line.starts_with("from ") {
+            parse_from(module, line, &mut lines, &mut parsed)?;
+        } else if let Some(rest) = line.strip_prefix("import ") {
+            parse_import(module, line, rest, &mut parsed)?;
         } else if line.starts_with("if __name__") {
             // The bundle itself ends with the call of the entry's main.
-            return Err(unsupported(line));
-        } else if let Some(name) = defined_name(line) {
-            parsed.defines.insert(name.to_string());
+            return Err(unsupported(module, line));
+        } else {
+            if let Some(name) = defined_name(line) {
+                parsed.defines.insert(name.to_string());
+            }
+            parsed.push(line);
         }
-        parsed.push(line);
     }
     Ok(parsed)
+}
+
+/// The triple-quoted string open after `line` (`None`: none is), given the one open
+/// before it.
+fn string_after<'q>(mut in_string: Option<&'q str>, line: &str) -> Option<&'q str> {
+    for quote in ["\"\"\"", "'''"] {
+        if in_string.is_none_or(|q| q == quote) && line.matches(quote).count() % 2 == 1 {
+            in_string = if in_string.is_some() {
+                None
+            } else {
+                Some(quote)
+            };
+        }
+    }
+    in_string
+}
+
+/// A top-level `from X import …` statement starting at `line` (a parenthesised list
+/// continues on the next of `lines`): a package import is recorded, any other kept.
+fn parse_from<'a>(
+    module: &str,
+    line: &'a str,
+    lines: &mut impl Iterator<Item = &'a str>,
+    parsed: &mut Parsed,
+) -> Result<(), BundleError> {
+    let rest = &line["from ".len()..];
+    let (from, names) = rest
+        .split_once(" import ")
+        .ok_or_else(|| unsupported(module, line))?;
+    let from = from.trim();
+    let mut statement = line.to_string();
+    let mut names = names.to_string();
+    if names.trim_start().starts_with('(') {
+        while !names.contains(')') {
+            let next = lines
+                .next()
+                .ok_or_else(|| unsupported(module, &statement))?;
+            statement.push_str(next);
+            names.push_str(next);
+        }
+    }
+    let names = imported_names(&names);
+    if from == "." || from == PACKAGE {
+        return Err(unsupported(module, &statement));
+    }
+    match package_module(from) {
+        Some(target) if is_identifier(target) && names.iter().all(|n| is_identifier(n)) => {
+            parsed.imports.push((target.to_string(), names));
+        }
+        Some(_) => return Err(unsupported(module, &statement)),
+        None if from.starts_with('.') => return Err(unsupported(module, &statement)),
+        None => {
+            // `from os import path as p` binds p.
+            let bound = names.iter().map(|n| match n.split_once(" as ") {
+                Some((_, alias)) => alias.trim().to_string(),
+                None => n.clone(),
+            });
+            parsed.imported.extend(bound);
+            parsed.push_import(&statement);
+        }
+    }
+    Ok(())
+}
+
+/// The names of an import list, with or without parentheses, comments dropped.
+fn imported_names(list: &str) -> Vec<String> {
+    list.lines()
+        .map(|l| l.split('#').next().unwrap_or(""))
+        .flat_map(|l| l.split(','))
+        .map(|n| n.trim().trim_matches(|c| c == '(' || c == ')').trim())
+        .filter(|n| !n.is_empty())
+        .map(str::to_string)
+        .collect()
+}
+
+/// A top-level `import …` line (`rest` after the keyword): kept, unless it names the
+/// package.
+fn parse_import(
+    module: &str,
+    line: &str,
+    rest: &str,
+    parsed: &mut Parsed,
+) -> Result<(), BundleError> {
+    for item in rest.split('#').next().unwrap_or("").split(',') {
+        let item = item.trim();
+        if item == PACKAGE || item.starts_with(&format!("{PACKAGE}.")) {
+            return Err(unsupported(module, line));
+        }
+        let bound = match item.split_once(" as ") {
+            Some((_, alias)) => alias.trim(),
+            None => item.split('.').next().unwrap_or(item),
+        };
+        parsed.imported.insert(bound.to_string());
+    }
+    parsed.push_import(line);
+    Ok(())
 }
 
 /// The modules `entry` needs and `entry` itself, dependencies first, from the package
@@ -317,44 +355,20 @@ fn bundle_from(
     for &(name, text) in modules.iter().chain(extra.as_ref()) {
         parsed.insert(name.to_string(), parse(name, text)?);
     }
+    check_entry(&parsed, extra, entry)?;
     // Depth first: a module is emitted once everything it imports is.
     let mut order: Vec<String> = Vec::new();
-    let mut path: Vec<String> = Vec::new();
-    fn visit(
-        name: &str,
-        parsed: &BTreeMap<String, Parsed>,
-        order: &mut Vec<String>,
-        path: &mut Vec<String>,
-    ) -> Result<(), BundleError> {
-        if order.iter().any(|n| n == name) {
-            return Ok(());
-        }
-        if let Some(start) = path.iter().position(|n| n == name) {
-            let mut cycle = path[start..].to_vec();
-            cycle.push(name.to_string());
-            return Err(BundleError::Cycle(cycle));
-        }
-        path.push(name.to_string());
-        for (target, names) in &parsed[name].imports {
-            let Some(module) = parsed.get(target) else {
-                return Err(BundleError::UnknownModule {
-                    module: name.to_string(),
-                    imports: format!("{PACKAGE}.{target}"),
-                });
-            };
-            if let Some(missing) = names.iter().find(|n| !module.defines.contains(*n)) {
-                return Err(BundleError::UnknownName {
-                    module: name.to_string(),
-                    from: target.clone(),
-                    name: missing.clone(),
-                });
-            }
-            visit(target, parsed, order, path)?;
-        }
-        path.pop();
-        order.push(name.to_string());
-        Ok(())
-    }
+    visit(entry, &parsed, &mut order, &mut Vec::new())?;
+    check_one_namespace(&parsed, &order)?;
+    Ok(parts(order, parsed))
+}
+
+/// `entry` must be a module, and `extra` (not part of the package) imported by none.
+fn check_entry(
+    parsed: &BTreeMap<String, Parsed>,
+    extra: Option<(&str, &str)>,
+    entry: &str,
+) -> Result<(), BundleError> {
     if !parsed.contains_key(entry) {
         return Err(BundleError::UnknownModule {
             module: entry.to_string(),
@@ -373,12 +387,55 @@ fn bundle_from(
             });
         }
     }
-    visit(entry, &parsed, &mut order, &mut path)?;
+    Ok(())
+}
 
-    // One namespace: each top-level name bound by one module only (an import of the
-    // same standard module by several is the same binding, and is allowed).
+/// Appends `name` to `order` after everything it imports, depth first; `path` is the
+/// chain of imports being followed, to name a cycle.
+fn visit(
+    name: &str,
+    parsed: &BTreeMap<String, Parsed>,
+    order: &mut Vec<String>,
+    path: &mut Vec<String>,
+) -> Result<(), BundleError> {
+    if order.iter().any(|n| n == name) {
+        return Ok(());
+    }
+    if let Some(start) = path.iter().position(|n| n == name) {
+        let mut cycle = path[start..].to_vec();
+        cycle.push(name.to_string());
+        return Err(BundleError::Cycle(cycle));
+    }
+    path.push(name.to_string());
+    for (target, names) in &parsed[name].imports {
+        let Some(module) = parsed.get(target) else {
+            return Err(BundleError::UnknownModule {
+                module: name.to_string(),
+                imports: format!("{PACKAGE}.{target}"),
+            });
+        };
+        if let Some(missing) = names.iter().find(|n| !module.defines.contains(*n)) {
+            return Err(BundleError::UnknownName {
+                module: name.to_string(),
+                from: target.clone(),
+                name: missing.clone(),
+            });
+        }
+        visit(target, parsed, order, path)?;
+    }
+    path.pop();
+    order.push(name.to_string());
+    Ok(())
+}
+
+/// One namespace: each top-level name bound by one module only (an import of the same
+/// standard module by several is the same binding, and is allowed).
+fn check_one_namespace(
+    parsed: &BTreeMap<String, Parsed>,
+    order: &[String],
+) -> Result<(), BundleError> {
     let mut defined_by: BTreeMap<&str, &str> = BTreeMap::new();
-    for name in &order {
+    for name in order {
         for defined in &parsed[name].defines {
             if let Some(first) = defined_by.insert(defined, name) {
                 return Err(BundleError::DuplicateName {
@@ -389,7 +446,7 @@ fn bundle_from(
             }
         }
     }
-    for name in &order {
+    for name in order {
         for imported in &parsed[name].imported {
             if let Some(&owner) = defined_by.get(imported.as_str()) {
                 return Err(BundleError::DuplicateName {
@@ -400,10 +457,14 @@ fn bundle_from(
             }
         }
     }
-    // An import an earlier module of the bundle made already is not repeated: the name
-    // is bound in the one namespace, to the same module.
+    Ok(())
+}
+
+/// The modules in `order` as parts. An import an earlier module of the bundle made
+/// already is not repeated: the name is bound in the one namespace, to the same module.
+fn parts(order: Vec<String>, mut parsed: BTreeMap<String, Parsed>) -> Vec<Part> {
     let mut imported = BTreeSet::new();
-    Ok(order
+    order
         .into_iter()
         .map(|name| {
             let mut text = String::new();
@@ -417,7 +478,7 @@ fn bundle_from(
                 text,
             }
         })
-        .collect())
+        .collect()
 }
 
 /// The package modules the module `entry` needs and `entry` itself, dependencies first.

@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 
 use super::{deviation, png};
 use crate::verify::verdict::MIN_RING_PIXELS;
-use crate::verify::{Rendered, VerifyReport, reference_label};
+use crate::verify::{Rendered, Row, VerifyReport, reference_label};
 
 /// The colours of the verdict banner (the browser test looks for them).
 pub const PASS_COLOUR: &str = "#1b7a2f";
@@ -17,7 +17,6 @@ pub const FAIL_COLOUR: &str = "#b3261e";
 /// `rerun` is the command line that reproduces the whole check (the CLI passes its own);
 /// `files` are the report's other files, linked by name.
 pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[String]) -> String {
-    let info = &report.render;
     let failed = report.rows.iter().filter(|r| !r.pass).count();
     let verdict = if report.pass { "PASS" } else { "FAIL" };
     let banner = if report.pass {
@@ -26,6 +25,21 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         FAIL_COLOUR
     };
     let mut s = String::new();
+    write_head(&mut s, verdict, banner);
+    write_banner(&mut s, report, verdict, failed);
+    write_thresholds(&mut s, report);
+    write_rerun(&mut s, report, rerun);
+    write_notes(&mut s, report);
+    write_spheres(&mut s, report, rendered);
+    write_scale(&mut s);
+    write_reference(&mut s, report, rendered);
+    write_files(&mut s, files);
+    s.push_str("</main></body></html>\n");
+    s
+}
+
+/// The document's start: its title and the style sheet, up to the opening `<body>`.
+fn write_head(s: &mut String, verdict: &str, banner: &str) {
     let _ = write!(
         s,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
@@ -47,6 +61,12 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         css(deviation::colour(0.0)),
         css(deviation::colour(deviation::SCALE)),
     );
+}
+
+/// The coloured banner: the verdict, how many spheres kept their promise, and how the
+/// sweep was rendered; it opens `<main>`.
+fn write_banner(s: &mut String, report: &VerifyReport, verdict: &str, failed: usize) {
+    let info = &report.render;
     let _ = writeln!(
         s,
         "<header><h1>{verdict}: {} of {} corrected spheres as promised</h1>\
@@ -69,6 +89,10 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         info.seed,
         info.render_seconds,
     );
+}
+
+/// The named thresholds the verdict applies.
+fn write_thresholds(s: &mut String, report: &VerifyReport) {
     let _ = writeln!(
         s,
         "<h2>Thresholds</h2><ul>\
@@ -79,6 +103,11 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         report.ring_tolerance_percent,
         100.0 * deviation::SCALE,
     );
+}
+
+/// The commands that rerun the check and its Blender render, and the render's log.
+fn write_rerun(s: &mut String, report: &VerifyReport, rerun: &str) {
+    let info = &report.render;
     let _ = writeln!(
         s,
         "<h2>Rerun</h2><p>This check:</p><pre>{}</pre><p>Its Blender render (log: <code>{}</code>):</p><pre>{}</pre>",
@@ -86,13 +115,22 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
         escape(&info.log),
         escape(&info.command)
     );
-    if !report.notes.is_empty() {
-        s.push_str("<h2>Notes</h2><ul>");
-        for n in &report.notes {
-            let _ = write!(s, "<li>{}</li>", escape(&super::notes::sentence(n)));
-        }
-        s.push_str("</ul>\n");
+}
+
+/// The report's notes as a list; nothing when it has none.
+fn write_notes(s: &mut String, report: &VerifyReport) {
+    if report.notes.is_empty() {
+        return;
     }
+    s.push_str("<h2>Notes</h2><ul>");
+    for n in &report.notes {
+        let _ = write!(s, "<li>{}</li>", escape(&super::notes::sentence(n)));
+    }
+    s.push_str("</ul>\n");
+}
+
+/// The spheres' table, failures first: numbers, two thumbnails and the false-colour one.
+fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
     // Layered mode compares the hand-made Mix Shader with the layered group.
     let (plain, fixed) = match report.mode {
         crate::generate::Mode::Layered => ("Mix Shader", "layered"),
@@ -104,78 +142,97 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
          <th>{fixed}</th><th>predicted</th><th>±SE</th><th>worst ring</th>\
          <th>{plain}</th><th>{fixed}</th><th>deviation</th></tr>",
     );
-    let plan = &rendered.plan;
-    let cell = plan.settings.cell as usize;
-    let thumb = |i: usize| {
-        png_tag(
-            &png::cell_image(&rendered.image, plan.columns, cell, i),
-            cell,
-        )
-    };
     let mut rows: Vec<_> = report.rows.iter().collect();
     rows.sort_by_key(|r| r.pass);
     for row in rows {
-        let cells = &plan.rows[row.id];
-        let false_colour = png_tag(
-            &deviation::cell_image(rendered, cells.corrected, &row.ring_targets),
-            cell,
-        );
-        let (class, status) = if row.pass {
-            ("ok", "ok")
-        } else {
-            ("fail", "FAIL")
-        };
-        let _ = writeln!(
-            s,
-            "<tr class=\"{class}\"><td class=\"{class}\">{status}</td><td class=\"name\">{} r = {}</td>\
-             <td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td>\
-             <td>{}</td><td>{}</td><td>{false_colour}</td></tr>",
-            escape(&row.series()),
-            row.roughness,
-            100.0 * row.uncorrected_brightness,
-            100.0 * row.brightness,
-            100.0 * row.predicted_corrected,
-            100.0 * row.corrected.standard_error,
-            100.0 * row.worst_ring,
-            thumb(cells.uncorrected),
-            thumb(cells.corrected),
-        );
+        write_sphere_row(s, row, rendered);
     }
     s.push_str("</table>\n");
+}
+
+/// One sphere's row of the spheres' table.
+fn write_sphere_row(s: &mut String, row: &Row, rendered: &Rendered) {
+    let cells = &rendered.plan.rows[row.id];
+    let false_colour = png_tag(
+        &deviation::cell_image(rendered, cells.corrected, &row.ring_targets),
+        rendered.plan.settings.cell as usize,
+    );
+    let (class, status) = if row.pass {
+        ("ok", "ok")
+    } else {
+        ("fail", "FAIL")
+    };
+    let _ = writeln!(
+        s,
+        "<tr class=\"{class}\"><td class=\"{class}\">{status}</td><td class=\"name\">{} r = {}</td>\
+         <td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td><td>{:.2} %</td>\
+         <td>{}</td><td>{}</td><td>{false_colour}</td></tr>",
+        escape(&row.series()),
+        row.roughness,
+        100.0 * row.uncorrected_brightness,
+        100.0 * row.brightness,
+        100.0 * row.predicted_corrected,
+        100.0 * row.corrected.standard_error,
+        100.0 * row.worst_ring,
+        thumbnail(rendered, cells.uncorrected),
+        thumbnail(rendered, cells.corrected),
+    );
+}
+
+/// The legend of the false-colour thumbnails.
+fn write_scale(s: &mut String) {
     let _ = writeln!(
         s,
         "<p>Deviation scale: <span style=\"display:inline-block;vertical-align:middle\" class=\"scale\"></span> \
          −{0} % (darker) · 0 · +{0} % (brighter)</p>",
         100.0 * deviation::SCALE
     );
-    if !report.reference.is_empty() {
+}
+
+/// The reference spheres' table; nothing when the sweep has none.
+fn write_reference(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
+    if report.reference.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "<h2>Reference: Blender's {}</h2><table><tr><th>sphere</th><th>r</th><th>brightness</th><th>±SE</th><th>sphere</th></tr>",
+        reference_label(report.mode)
+    );
+    for r in &report.reference {
         let _ = writeln!(
             s,
-            "<h2>Reference: Blender's {}</h2><table><tr><th>sphere</th><th>r</th><th>brightness</th><th>±SE</th><th>sphere</th></tr>",
-            reference_label(report.mode)
+            "<tr><td class=\"name\">{}</td><td>{}</td><td>{:.2} %</td><td>{:.2} %</td><td>{}</td></tr>",
+            escape(&r.series(report.mode)),
+            r.roughness,
+            100.0 * r.brightness,
+            100.0 * r.stats.standard_error,
+            thumbnail(rendered, r.cell)
         );
-        for r in &report.reference {
-            let _ = writeln!(
-                s,
-                "<tr><td class=\"name\">{}</td><td>{}</td><td>{:.2} %</td><td>{:.2} %</td><td>{}</td></tr>",
-                escape(&r.series(report.mode)),
-                r.roughness,
-                100.0 * r.brightness,
-                100.0 * r.stats.standard_error,
-                thumb(r.cell)
-            );
-        }
-        s.push_str("</table>\n");
     }
-    if !files.is_empty() {
-        s.push_str("<h2>Files</h2><ul>");
-        for f in files {
-            let _ = write!(s, "<li><a href=\"{0}\">{0}</a></li>", escape(f));
-        }
-        s.push_str("</ul>\n");
+    s.push_str("</table>\n");
+}
+
+/// Links to the report's other files; nothing when there are none.
+fn write_files(s: &mut String, files: &[String]) {
+    if files.is_empty() {
+        return;
     }
-    s.push_str("</main></body></html>\n");
-    s
+    s.push_str("<h2>Files</h2><ul>");
+    for f in files {
+        let _ = write!(s, "<li><a href=\"{0}\">{0}</a></li>", escape(f));
+    }
+    s.push_str("</ul>\n");
+}
+
+/// The rendered cell `i` as an inline `<img>`.
+fn thumbnail(rendered: &Rendered, i: usize) -> String {
+    let plan = &rendered.plan;
+    let cell = plan.settings.cell as usize;
+    png_tag(
+        &png::cell_image(&rendered.image, plan.columns, cell, i),
+        cell,
+    )
 }
 
 fn css([r, g, b]: [u8; 3]) -> String {

@@ -9,6 +9,36 @@ use crate::verify::VerifyReport;
 /// The verdict as a terminal table: a title line, one row per sphere, the references,
 /// the verdict line, notes, and the log and rerun command when something failed.
 pub fn render(report: &VerifyReport) -> String {
+    let mut s = String::new();
+    write_title(&mut s, report);
+    let layered = report.mode == Mode::Layered;
+    // Layered rows name the index too ("Ashikhmin-Shirley, IOR 1.33"), and the references
+    // Principled BSDF.
+    let w = if layered { 30 } else { 18 };
+    if layered {
+        let _ = writeln!(
+            s,
+            "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of what the layered coat promises"
+        );
+    }
+    // An EEVEE sweep shows, beside each plain sphere, what Cycles renders for it.
+    let eevee = report.engine == Engine::Eevee;
+    write_column_names(&mut s, w, layered, eevee);
+    write_spheres(&mut s, report, w, eevee);
+    write_references(&mut s, report, w, eevee);
+    write_verdict(&mut s, report);
+    for n in &report.notes {
+        let _ = writeln!(s, "note: {}", super::notes::sentence(n));
+    }
+    if !report.pass {
+        let i = &report.render;
+        let _ = writeln!(s, "log: {}\nrerun: {}", i.log, i.command);
+    }
+    s
+}
+
+/// How the sweep was rendered, and in which colour when it is not plain white.
+fn write_title(s: &mut String, report: &VerifyReport) {
     let i = &report.render;
     let white = report.color == [1.0; 3];
     let colour = if white && report.color_model == ColorModel::Exact {
@@ -25,30 +55,15 @@ pub fn render(report: &VerifyReport) -> String {
         Engine::Cycles => format!("{} masking", i.masking),
         Engine::Eevee => "EEVEE: every distribution renders as GGX".to_string(),
     };
-    let mut s = String::new();
     let _ = writeln!(
         s,
         "Blender {} ({engine}) · coefficients {} · {} px per sphere, {} spp, seed {} · rendered in {:.1} s{colour}",
         i.blender_version, report.coefficients, i.cell, i.samples, i.seed, i.render_seconds
     );
-    let average = |v: [f64; 3]| v.iter().sum::<f64>() / 3.0;
-    let layered = report.mode == Mode::Layered;
-    // Layered rows name the index too ("Ashikhmin-Shirley, IOR 1.33"), and the references
-    // Principled BSDF.
-    let w = if layered { 30 } else { 18 };
-    if layered {
-        let _ = writeln!(
-            s,
-            "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of what the layered coat promises"
-        );
-    }
-    // An EEVEE sweep shows, beside each plain sphere, what Cycles renders for it.
-    let eevee = report.engine == Engine::Eevee;
-    let cycles_column = |v: Option<f64>| match (eevee, v) {
-        (false, _) => String::new(),
-        (true, Some(v)) => format!(" {:>9.2}%", 100.0 * v),
-        (true, None) => format!(" {:>10}", ""),
-    };
+}
+
+/// The table's header line; the first column `w` wide.
+fn write_column_names(s: &mut String, w: usize, layered: bool, eevee: bool) {
     let _ = writeln!(
         s,
         "{:<w$} {:>5} {:>12}{} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
@@ -66,6 +81,10 @@ pub fn render(report: &VerifyReport) -> String {
         "centre",
         "ring Δ"
     );
+}
+
+/// One line per judged sphere.
+fn write_spheres(s: &mut String, report: &VerifyReport, w: usize, eevee: bool) {
     for r in &report.rows {
         let _ = writeln!(
             s,
@@ -73,7 +92,7 @@ pub fn render(report: &VerifyReport) -> String {
             r.series(),
             r.roughness,
             100.0 * r.uncorrected_brightness,
-            cycles_column(r.cycles_uncorrected),
+            cycles_column(eevee, r.cycles_uncorrected),
             100.0 * r.brightness,
             100.0 * r.corrected.standard_error / average(r.target),
             100.0 * r.predicted_corrected,
@@ -82,6 +101,10 @@ pub fn render(report: &VerifyReport) -> String {
             if r.pass { "ok" } else { "FAIL" }
         );
     }
+}
+
+/// One line per reference sphere.
+fn write_references(s: &mut String, report: &VerifyReport, w: usize, eevee: bool) {
     for r in &report.reference {
         let _ = writeln!(
             s,
@@ -89,13 +112,17 @@ pub fn render(report: &VerifyReport) -> String {
             r.series(report.mode),
             r.roughness,
             100.0 * r.brightness,
-            cycles_column(None),
+            cycles_column(eevee, None),
             "",
             100.0 * r.stats.standard_error / average(report.color),
             "",
             100.0 * r.stats.center / average(report.color)
         );
     }
+}
+
+/// The verdict line: how many corrected spheres kept within which tolerances.
+fn write_verdict(s: &mut String, report: &VerifyReport) {
     let failed = report.rows.iter().filter(|r| !r.pass).count();
     let rings = match report.mode {
         Mode::Roughness => String::new(),
@@ -113,11 +140,18 @@ pub fn render(report: &VerifyReport) -> String {
         report.mode,
         report.tolerance_percent
     );
-    for n in &report.notes {
-        let _ = writeln!(s, "note: {}", super::notes::sentence(n));
+}
+
+/// The "in Cycles" column of an EEVEE sweep (blank where Cycles has no value); nothing
+/// for a Cycles sweep.
+fn cycles_column(eevee: bool, v: Option<f64>) -> String {
+    match (eevee, v) {
+        (false, _) => String::new(),
+        (true, Some(v)) => format!(" {:>9.2}%", 100.0 * v),
+        (true, None) => format!(" {:>10}", ""),
     }
-    if !report.pass {
-        let _ = writeln!(s, "log: {}\nrerun: {}", i.log, i.command);
-    }
-    s
+}
+
+fn average(v: [f64; 3]) -> f64 {
+    v.iter().sum::<f64>() / 3.0
 }

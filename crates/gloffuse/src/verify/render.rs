@@ -8,7 +8,7 @@ use super::image::{Rgba, read_rgba};
 use super::plan::Plan;
 use super::stats::{SphereStats, sphere_stats};
 use crate::Error;
-use crate::blender::{Blender, BlenderOptions, Run, command_line, run_script, runs};
+use crate::blender::{Blender, BlenderOptions, Run, RunOutput, command_line, run_script, runs};
 use crate::generate::{GenerateParams, Job, Mode, assemble};
 use crate::output::write_output;
 use crate::progress::Progress;
@@ -65,54 +65,9 @@ pub fn render(
         log: log.clone(),
     };
     let command = command_line(&run);
-
-    progress.begin(
-        &format!(
-            "rendering {} spheres in Blender {}",
-            plan.cells.len(),
-            blender.version_string
-        ),
-        u64::from(plan.settings.samples),
-    );
-    // A watcher follows Cycles' "Sample N/M" lines in the log while Blender runs.
-    let done = AtomicBool::new(false);
-    let outcome = std::thread::scope(|scope| {
-        scope.spawn(|| {
-            while !done.load(Ordering::Relaxed) {
-                if let Some(s) = last_sample(&log) {
-                    progress.set(s);
-                }
-                std::thread::sleep(Duration::from_millis(200));
-            }
-        });
-        let outcome = run_script(&run);
-        done.store(true, Ordering::Relaxed);
-        outcome
-    });
-    progress.end();
-    let out = outcome?;
-    let image = read_rgba(&exr).map_err(|e| Error::Blender {
-        message: e.to_string().into(),
-        log: Some(log.clone()),
-        command: Some(command.clone()),
-    })?;
+    let out = run_followed(&run, plan, progress)?;
+    let image = read_sweep(&exr, plan, &log, &command)?;
     let cell = plan.settings.cell as usize;
-    let want = (plan.columns * cell, plan.image_rows() * cell);
-    if (image.width, image.height) != want {
-        return Err(Error::Blender {
-            message: format!(
-                "{} is {}×{} pixels; the plan needs {}×{}",
-                exr.display(),
-                image.width,
-                image.height,
-                want.0,
-                want.1
-            )
-            .into(),
-            log: Some(log),
-            command: Some(command),
-        });
-    }
     let stats = (0..plan.cells.len())
         .map(|i| sphere_stats(&image, i, plan.columns, cell, plan.settings.radius_fraction))
         .collect();
@@ -136,6 +91,63 @@ pub fn render(
         exr,
         plan: plan.clone(),
     })
+}
+
+/// Runs the render while `progress` follows the samples Cycles logs.
+fn run_followed(run: &Run, plan: &Plan, progress: &dyn Progress) -> Result<RunOutput, Error> {
+    progress.begin(
+        &format!(
+            "rendering {} spheres in Blender {}",
+            plan.cells.len(),
+            run.blender.version_string
+        ),
+        u64::from(plan.settings.samples),
+    );
+    // A watcher follows Cycles' "Sample N/M" lines in the log while Blender runs.
+    let done = AtomicBool::new(false);
+    let outcome = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !done.load(Ordering::Relaxed) {
+                if let Some(s) = last_sample(&run.log) {
+                    progress.set(s);
+                }
+                std::thread::sleep(Duration::from_millis(200));
+            }
+        });
+        let outcome = run_script(run);
+        done.store(true, Ordering::Relaxed);
+        outcome
+    });
+    progress.end();
+    outcome
+}
+
+/// The rendered EXR, which must be as large as `plan` needs; a failure names the render's
+/// log and command.
+fn read_sweep(exr: &Path, plan: &Plan, log: &Path, command: &str) -> Result<Rgba, Error> {
+    let image = read_rgba(exr).map_err(|e| Error::Blender {
+        message: e.to_string().into(),
+        log: Some(log.to_path_buf()),
+        command: Some(command.to_string()),
+    })?;
+    let cell = plan.settings.cell as usize;
+    let want = (plan.columns * cell, plan.image_rows() * cell);
+    if (image.width, image.height) != want {
+        return Err(Error::Blender {
+            message: format!(
+                "{} is {}×{} pixels; the plan needs {}×{}",
+                exr.display(),
+                image.width,
+                image.height,
+                want.0,
+                want.1
+            )
+            .into(),
+            log: Some(log.to_path_buf()),
+            command: Some(command.to_string()),
+        });
+    }
+    Ok(image)
 }
 
 /// The highest "Sample N/M" Cycles has logged so far.

@@ -38,6 +38,7 @@ pub struct SphereStats {
 
 /// Statistics of cell `index` in a grid of `columns` cells of `cell` pixels, where the
 /// sphere's diameter is `radius_fraction` of the cell.
+// Long on purpose: one numeric pass; a single pixel loop feeds every sum the summary reads.
 pub fn sphere_stats(
     img: &Rgba,
     index: usize,
