@@ -39,6 +39,8 @@ def parse_generate_args(argv=None):
                         help="open this .blend file first (default: the file already open)")
     parser.add_argument("--save", metavar="OUT.blend",
                         help="save the result as this .blend file (default: do not save)")
+    parser.add_argument("--compress", action="store_true",
+                        help="save compressed (as the file opened was)")
     return parse_script_args(parser, argv)
 
 
@@ -55,7 +57,7 @@ def generate_main(document_text):
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
             render_previews(built, directory)
-    saved = save_blend(options.save) if options.save else None
+    saved = save_blend(options.save, options.compress) if options.save else None
     names = []
     for _spec, trees in built:
         names.extend(tree.name for tree in trees)

@@ -9,7 +9,7 @@
 #
 #   script_args(argv=None) -> the arguments meant for the script
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
-#   open_blend(path), save_blend(path) -> absolute path
+#   open_blend(path), save_blend(path, compress) -> absolute path
 #   result_line(payload) -> "GLOFFUSE_RESULT {...}"
 #   run_main(main) -> runs main with the error handling described there
 # ---------------------------------------------------------------------------
@@ -72,9 +72,10 @@ def open_blend(path):
     return path
 
 
-def save_blend(path):
+def save_blend(path, compress=False):
     """Save the open file as `path` without a .blend1 backup (the caller
-    handles backups and atomic renames)."""
+    handles backups and atomic renames), compressed if asked (as the user's
+    file was: gloffuse keeps a file's compression)."""
     path = os.path.abspath(path)
     directory = os.path.dirname(path)
     if directory and not os.path.isdir(directory):
@@ -84,7 +85,7 @@ def save_blend(path):
     filepaths.save_version = 0
     try:
         result = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False,
-                                             copy=False, compress=False)
+                                             copy=False, compress=compress)
     finally:
         filepaths.save_version = old_versions
     if "FINISHED" not in result or not os.path.isfile(path):

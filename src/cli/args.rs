@@ -551,6 +551,12 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "EXISTING.blend")]
     pub into: Option<PathBuf>,
 
+    /// Let --into open a file saved by a newer Blender than the one that runs. Without it,
+    /// such a file is refused: the older Blender would drop what it does not know (newer
+    /// nodes become undefined ones) when it saves.
+    #[arg(long, requires = "into")]
+    pub allow_downgrade: bool,
+
     /// Write a Blender extension (4.2+): drag the .zip into Blender, or Edit ▸ Preferences ▸
     /// Get Extensions ▸ Install from Disk. Enabling it registers the library as the asset
     /// library "Gloffuse", so the groups show in the Asset Browser and in the shader
@@ -592,6 +598,7 @@ impl GenerateArgs {
             script: self.script.clone(),
             blend: self.blend.clone(),
             into: self.into.clone(),
+            allow_downgrade: self.allow_downgrade,
             extension: self.extension.clone(),
             modes: self.mode.clone(),
             engines: self.engine.clone(),
@@ -899,6 +906,7 @@ pub fn flag(field: Field) -> String {
         Field::Format => "--format",
         Field::GModel => "--g-model",
         Field::Into => "--into",
+        Field::AllowDowngrade => "--allow-downgrade",
         Field::Ior => "--ior",
         Field::FitSource => "--from",
         Field::Kind => "--kind",

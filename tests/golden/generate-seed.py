@@ -1899,7 +1899,7 @@ def sphere_mesh(name, radius, segments, rings, cut_below=None):
 #
 #   script_args(argv=None) -> the arguments meant for the script
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
-#   open_blend(path), save_blend(path) -> absolute path
+#   open_blend(path), save_blend(path, compress) -> absolute path
 #   result_line(payload) -> "GLOFFUSE_RESULT {...}"
 #   run_main(main) -> runs main with the error handling described there
 # ---------------------------------------------------------------------------
@@ -1960,9 +1960,10 @@ def open_blend(path):
     return path
 
 
-def save_blend(path):
+def save_blend(path, compress=False):
     """Save the open file as `path` without a .blend1 backup (the caller
-    handles backups and atomic renames)."""
+    handles backups and atomic renames), compressed if asked (as the user's
+    file was: gloffuse keeps a file's compression)."""
     path = os.path.abspath(path)
     directory = os.path.dirname(path)
     if directory and not os.path.isdir(directory):
@@ -1972,7 +1973,7 @@ def save_blend(path):
     filepaths.save_version = 0
     try:
         result = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False,
-                                             copy=False, compress=False)
+                                             copy=False, compress=compress)
     finally:
         filepaths.save_version = old_versions
     if "FINISHED" not in result or not os.path.isfile(path):
@@ -2177,6 +2178,8 @@ def parse_generate_args(argv=None):
                         help="open this .blend file first (default: the file already open)")
     parser.add_argument("--save", metavar="OUT.blend",
                         help="save the result as this .blend file (default: do not save)")
+    parser.add_argument("--compress", action="store_true",
+                        help="save compressed (as the file opened was)")
     return parse_script_args(parser, argv)
 
 
@@ -2193,7 +2196,7 @@ def generate_main(document_text):
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
             render_previews(built, directory)
-    saved = save_blend(options.save) if options.save else None
+    saved = save_blend(options.save, options.compress) if options.save else None
     names = []
     for _spec, trees in built:
         names.extend(tree.name for tree in trees)

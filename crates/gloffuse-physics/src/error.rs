@@ -140,6 +140,8 @@ pub enum Field {
     GModel,
     /// The user's existing .blend to update in place.
     Into,
+    /// Whether a file saved by a newer Blender may be opened and saved by an older one.
+    AllowDowngrade,
     /// Indices of refraction.
     Ior,
     /// Where a fit's points come from (the integrator, rather than points given).
@@ -196,6 +198,7 @@ impl Field {
             Field::Format => "format",
             Field::GModel => "masking model",
             Field::Into => "file to update",
+            Field::AllowDowngrade => "permission to downgrade the file",
             Field::Ior => "index of refraction",
             Field::FitSource => "fit source",
             Field::Kind => "table kind",

@@ -4,7 +4,8 @@
 //! `gloffuse-physics` crate) → [`fit`] (curves and the coefficients file) → [`generate`]
 //! (the node groups) → [`verify`] (furnace renders and the verdict) → [`report`] (renderers
 //! of the verdict). [`albedo`], [`lut`], [`refresh`] and [`bench`] are commands composed of
-//! those stages; [`blender`] runs Blender. The library returns data and never prints or
+//! those stages; [`blender`] runs Blender, [`output`] writes the files the user names and
+//! [`user_blend`] changes a user's .blend in place. The library returns data and never prints or
 //! parses flags: long work reports through [`progress::Progress`], and errors name their
 //! input by a typed [`Field`]. See `docs/ARCHITECTURE.md`.
 
@@ -19,6 +20,7 @@ pub mod lut;
 pub mod output;
 pub mod refresh;
 pub mod report;
+pub mod user_blend;
 pub mod verify;
 
 pub use error::{Error, Field, Hint, Result};

@@ -213,3 +213,26 @@ pub fn make_report_dir(dir: &Path) -> Result<(), Error> {
         _ => Ok(()),
     }
 }
+
+/// A temporary file next to `dest`, removed on drop unless persisted.
+pub fn temp_beside(dest: &Path, suffix: &str) -> Result<tempfile::TempPath, Error> {
+    let dir = match dest.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(Error::Write {
+            path: dest.to_path_buf(),
+            message: format!("the directory {} does not exist", dir.display()),
+        });
+    }
+    tempfile::Builder::new()
+        .prefix(".gloffuse-")
+        .suffix(suffix)
+        .tempfile_in(dir)
+        .map(|f| f.into_temp_path())
+        .map_err(|e| Error::Write {
+            path: dest.to_path_buf(),
+            message: e.to_string(),
+        })
+}

@@ -23,9 +23,10 @@ use crate::blender::{Blender, BlenderOptions, Run, command_line, run_script};
 use crate::error::{Error, Field, Hint};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
-use crate::output::{Destination, check_destination, write_output};
+use crate::output::{Destination, check_destination, temp_beside, write_output};
 use crate::progress::Progress;
-use blend::{incomplete_blend, starts_like_blend, temp_beside};
+use crate::user_blend::{UserBlend, read_header};
+use blend::incomplete_blend;
 
 /// What `generate` writes, and from what.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,6 +39,9 @@ pub struct GenerateOptions {
     pub blend: Option<PathBuf>,
     /// Add or replace the groups in this existing .blend, in place (keeping a .blend1).
     pub into: Option<PathBuf>,
+    /// Let `into` be a file saved by a newer Blender than the one that runs (its newer
+    /// data is lost).
+    pub allow_downgrade: bool,
     /// Write a Blender extension (.zip) that installs the library as an asset library.
     pub extension: Option<PathBuf>,
     /// Which groups to build besides the roughness-only pair.
@@ -55,6 +59,7 @@ impl Default for GenerateOptions {
             script: None,
             blend: None,
             into: None,
+            allow_downgrade: false,
             extension: None,
             modes: vec![Mode::Roughness],
             engines: Vec::new(),
@@ -96,14 +101,18 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
     }
     if let Some(into) = &g.into {
         let expected = if !into.is_file() {
-            Some("an existing .blend file")
-        } else if !starts_like_blend(into) {
-            Some("an existing .blend file (this file does not start with a .blend header)")
+            Some("an existing .blend file".to_string())
         } else {
-            None
+            read_header(into)
+                .err()
+                .map(|why| format!("an existing .blend file (this file {why})"))
         };
         if let Some(expected) = expected {
-            return Err(Error::input(Field::Into, into.display(), expected));
+            return Err(Error::input(
+                Field::Into,
+                into.display(),
+                Hint::text(expected),
+            ));
         }
         if g.blend.is_some() || g.extension.is_some() {
             return Err(Error::input(
@@ -204,7 +213,13 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         write_script(g, &script, &mut out)?;
         return Ok(out);
     };
-    let built = run_blender(g, &blender, &script)?;
+    // The user's file is checked against the Blender found before that Blender starts.
+    let user_blend = g
+        .into
+        .as_deref()
+        .map(|into| UserBlend::open(into, Field::Into, blender.version, g.allow_downgrade))
+        .transpose()?;
+    let built = run_blender(g, &blender, &script, user_blend.as_ref())?;
     out.log = Some(built.log.clone());
     // Everything is made before anything is written: a failed run leaves no output at all.
     let package = package_extension(g, &built, &params, &blender)?;
@@ -213,7 +228,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         write_output(zip, bytes)?;
         out.extension = Some(zip.clone());
     }
-    install_blend(g, built, &mut out)?;
+    install_blend(built, user_blend.as_ref(), &mut out)?;
     write_catalogs(catalogs, &mut out)?;
     Ok(out)
 }
@@ -327,8 +342,14 @@ struct Built {
 }
 
 /// Runs the script in `blender`, saving the .blend under a temporary name, and checks that
-/// Blender wrote a whole .blend.
-fn run_blender(g: &GenerateOptions, blender: &Blender, script: &str) -> Result<Built, Error> {
+/// Blender wrote a whole .blend. The user's file (`--into`) is opened where it really is and
+/// saved beside it, compressed as it was.
+fn run_blender(
+    g: &GenerateOptions,
+    blender: &Blender,
+    script: &str,
+    user_blend: Option<&UserBlend>,
+) -> Result<Built, Error> {
     let run_dir = crate::blender::runs::new_run_dir("generate")?;
     let script_path = run_dir.join("gloffuse-generate.py");
     write_output(&script_path, script.as_bytes())?;
@@ -339,15 +360,22 @@ fn run_blender(g: &GenerateOptions, blender: &Blender, script: &str) -> Result<B
         Some(dest) => check_destination(dest)?,
         None => Destination::Stream(run_dir.join(extension::LIBRARY_FILE)),
     };
-    let tmp = match &target {
-        Destination::File(real) => temp_beside(real, ".blend")?,
-        Destination::Stream(_) | Destination::Stdout => {
+    let tmp = match (&target, user_blend) {
+        (_, Some(user_blend)) => user_blend.temp()?,
+        (Destination::File(real), None) => temp_beside(real, ".blend")?,
+        (Destination::Stream(_) | Destination::Stdout, None) => {
             temp_beside(&run_dir.join("out"), ".blend")?
         }
     };
     let mut args: Vec<OsString> = Vec::new();
-    if let Some(into) = &g.into {
-        args.extend([OsString::from("--open"), into.clone().into_os_string()]);
+    if let Some(user_blend) = user_blend {
+        args.extend([
+            OsString::from("--open"),
+            user_blend.real.clone().into_os_string(),
+        ]);
+        if user_blend.compressed() {
+            args.push(OsString::from("--compress"));
+        }
     }
     args.extend([OsString::from("--save"), tmp.to_path_buf().into_os_string()]);
     let log = run_dir.join("blender.log");
@@ -397,25 +425,24 @@ fn package_extension(
     )?))
 }
 
-/// Puts the saved .blend in its destination, if it has one: renamed over the file (after a backup of a
-/// file changed in place), or copied to a stream.
-fn install_blend(g: &GenerateOptions, built: Built, out: &mut Generated) -> Result<(), Error> {
+/// Puts the saved .blend in its destination, if it has one: the user's file replaced the
+/// safe way (its previous version kept as .blend1), a new file renamed into place, or the
+/// bytes copied to a stream.
+fn install_blend(
+    built: Built,
+    user_blend: Option<&UserBlend>,
+    out: &mut Generated,
+) -> Result<(), Error> {
     let Built {
         tmp, dest, target, ..
     } = built;
     let Some(dest) = dest else {
         return Ok(());
     };
-    if let (Some(_), Destination::File(real)) = (&g.into, &target) {
-        // Blender's own convention: the previous version stays beside the file as .blend1.
-        let mut backup = real.clone().into_os_string();
-        backup.push("1");
-        let backup = PathBuf::from(backup);
-        std::fs::copy(real, &backup).map_err(|e| Error::Write {
-            path: backup.clone(),
-            message: e.to_string(),
-        })?;
-        out.backup = Some(backup);
+    if let Some(user_blend) = user_blend {
+        out.backup = Some(user_blend.install(tmp)?);
+        out.blend = Some(dest);
+        return Ok(());
     }
     match &target {
         Destination::File(real) => tmp.persist(real).map_err(|e| Error::Write {

@@ -1,0 +1,315 @@
+//! The one safe path for changing a .blend the user owns (`generate --into`, and any later
+//! command that edits a user's file in place). A user's file is never downgraded,
+//! truncated, re-moded or silently rewritten:
+//!
+//! 1. [`UserBlend::open`] reads the file's header before Blender starts: the version that
+//!    saved it and whether it is compressed. A file saved by a newer Blender than the one
+//!    that would open it is refused (opening loses what the older one does not know)
+//!    unless a downgrade is allowed.
+//! 2. Blender opens the canonical path (every link followed), so the file's `//` relative
+//!    paths resolve from the folder the file really is in, and saves beside that real file
+//!    ([`UserBlend::temp`]), compressed exactly when the user's file is.
+//! 3. [`UserBlend::install`] gives the new file the old one's permission bits, hard-links
+//!    the old file to a temporary name beside it (a copy where links are not supported),
+//!    renames the new file over the old one and only then renames the link to
+//!    `FILE.blend1`. A failure before the main rename removes the link and leaves the file
+//!    and any earlier `.blend1` untouched; the backup is never a partial copy.
+
+use std::io::Read;
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+
+use crate::measure::BlenderVersion;
+use crate::{Error, Field, Hint};
+
+/// How a .blend's bytes are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compression {
+    None,
+    /// Zstandard: Blender 3.0 and later.
+    Zstd,
+    /// Gzip: Blender before 3.0.
+    Gzip,
+}
+
+/// What the first bytes of a .blend say.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlendHeader {
+    /// The Blender that saved it; `None` for a gzip file, which only Blender before 3.0
+    /// wrote (older than every Blender gloffuse runs).
+    pub version: Option<BlenderVersion>,
+    pub compression: Compression,
+}
+
+/// The zstd frame magic, the gzip magic.
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// The header of the .blend bytes `head` (the file's first bytes, decompressed): the
+/// 12-byte form `BLENDER-v405` (pointer size, endianness, 3-digit version), or the form
+/// Blender 5.0 introduced, `BLENDER17-01v0500` (header size, format version, 4-digit version).
+pub fn parse_version(head: &[u8]) -> Option<BlenderVersion> {
+    let rest = head.strip_prefix(b"BLENDER")?;
+    let digits = match rest.first()? {
+        b'-' | b'_' => rest.get(2..5)?,
+        b'0'..=b'9' => {
+            let header_size = std::str::from_utf8(rest.get(..2)?).ok()?;
+            let header_size: usize = header_size.parse().ok()?;
+            // 7 (BLENDER) + 2 (size) + 1 (pointer) + 2 (format) + 1 (endianness) + digits.
+            rest.get(6..header_size.checked_sub(7)?)?
+        }
+        _ => return None,
+    };
+    if !digits.iter().all(u8::is_ascii_digit) || digits.len() < 3 {
+        return None;
+    }
+    let number: u32 = std::str::from_utf8(digits).ok()?.parse().ok()?;
+    Some(BlenderVersion {
+        major: number / 100,
+        minor: number % 100,
+    })
+}
+
+/// Reads the header of the .blend at `path` (decompressing the start of a zstd file).
+pub fn read_header(path: &Path) -> Result<BlendHeader, String> {
+    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+    let mut head = [0u8; 17];
+    let n = read_up_to(&mut file, &mut head).map_err(|e| format!("cannot be read ({e})"))?;
+    let head = &head[..n];
+    let not_blend = || "does not start with a .blend header".to_string();
+    if head.starts_with(&GZIP_MAGIC) {
+        return Ok(BlendHeader {
+            version: None,
+            compression: Compression::Gzip,
+        });
+    }
+    if head.starts_with(&ZSTD_MAGIC) {
+        let file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+        let mut decoder = ruzstd::decoding::StreamingDecoder::new(file)
+            .map_err(|e| format!("is compressed, but its zstd stream cannot be read ({e})"))?;
+        let mut inner = [0u8; 17];
+        let n = read_up_to(&mut decoder, &mut inner)
+            .map_err(|e| format!("is compressed, but its zstd stream cannot be read ({e})"))?;
+        let version = parse_version(&inner[..n]).ok_or_else(not_blend)?;
+        return Ok(BlendHeader {
+            version: Some(version),
+            compression: Compression::Zstd,
+        });
+    }
+    let version = parse_version(head).ok_or_else(not_blend)?;
+    Ok(BlendHeader {
+        version: Some(version),
+        compression: Compression::None,
+    })
+}
+
+/// Fills `buf` as far as the reader goes; returns how many bytes were read.
+fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match reader.read(&mut buf[filled..])? {
+            0 => break,
+            n => filled += n,
+        }
+    }
+    Ok(filled)
+}
+
+/// A user's .blend, checked and ready to be changed in place.
+#[derive(Clone, Debug)]
+pub struct UserBlend {
+    /// The path as the user gave it (maybe a link).
+    pub given: PathBuf,
+    /// The file itself, every link followed: what Blender opens and what is replaced.
+    pub real: PathBuf,
+    pub header: BlendHeader,
+    /// Its permission bits, given to the new file.
+    mode: u32,
+}
+
+impl UserBlend {
+    /// Checks `path` before Blender starts: it must be a .blend, and not newer than
+    /// `blender` unless `allow_downgrade`. `field` names the input in errors.
+    pub fn open(
+        path: &Path,
+        field: Field,
+        blender: BlenderVersion,
+        allow_downgrade: bool,
+    ) -> Result<UserBlend, Error> {
+        let meta = std::fs::metadata(path)
+            .ok()
+            .filter(|m| m.is_file())
+            .ok_or_else(|| Error::input(field, path.display(), "an existing .blend file"))?;
+        let header = read_header(path).map_err(|why| {
+            Error::input(
+                field,
+                path.display(),
+                Hint::text(format!("an existing .blend file (this file {why})")),
+            )
+        })?;
+        if let Some(saved_by) = header.version
+            && newer(saved_by, blender)
+            && !allow_downgrade
+        {
+            return Err(Error::input(
+                field,
+                path.display(),
+                Hint::new(
+                    format!(
+                        "a file saved by Blender {blender} or older: this one was saved by \
+                         Blender {saved_by}, and saving it from {blender} would lose what \
+                         {blender} does not know (run a Blender {saved_by} or newer with {{}}, \
+                         or accept the loss with {{}})",
+                    ),
+                    [Field::Blender, Field::AllowDowngrade],
+                ),
+            ));
+        }
+        let real = std::fs::canonicalize(path).map_err(|e| Error::Read {
+            path: path.to_path_buf(),
+            source: e,
+        })?;
+        Ok(UserBlend {
+            given: path.to_path_buf(),
+            real,
+            header,
+            mode: meta.permissions().mode() & 0o7777,
+        })
+    }
+
+    /// Whether Blender should save the new file compressed.
+    pub fn compressed(&self) -> bool {
+        self.header.compression != Compression::None
+    }
+
+    /// `FILE.blend1`, beside the real file: Blender's own name for the previous version.
+    pub fn backup_path(&self) -> PathBuf {
+        let mut backup = self.real.clone().into_os_string();
+        backup.push("1");
+        PathBuf::from(backup)
+    }
+
+    /// A temporary file beside the real file, for Blender to save into.
+    pub fn temp(&self) -> Result<tempfile::TempPath, Error> {
+        crate::output::temp_beside(&self.real, ".blend")
+    }
+
+    /// Puts the new file `new` (beside the real file) in place, keeping the old one as
+    /// `FILE.blend1` (see the module docs for the order). Returns the backup's path.
+    pub fn install(&self, new: tempfile::TempPath) -> Result<PathBuf, Error> {
+        let fail = |path: &Path, what: &str, e: std::io::Error| Error::Write {
+            path: path.to_path_buf(),
+            message: format!("{what}: {e}; {} is unchanged", self.given.display()),
+        };
+        std::fs::set_permissions(&new, std::fs::Permissions::from_mode(self.mode)).map_err(
+            |e| {
+                fail(
+                    &self.given,
+                    "cannot give the new file the old one's mode",
+                    e,
+                )
+            },
+        )?;
+        let backup = self.backup_path();
+        let old = self.keep_old()?;
+        std::fs::rename(&new, &self.real)
+            .map_err(|e| fail(&self.given, "cannot replace the file", e))?;
+        // The new file is in place under the old name: nothing is left to clean up.
+        drop(new);
+        if let Err(e) = old.persist(&backup) {
+            // The previous version must survive: keep it under its temporary name.
+            let mut link = e.path;
+            link.disable_cleanup(true);
+            let kept = link.to_path_buf();
+            return Err(Error::Write {
+                path: backup,
+                message: format!(
+                    "{} was updated, but its previous version could not be renamed to this \
+                     name ({}); it is kept as {}",
+                    self.given.display(),
+                    e.error,
+                    kept.display()
+                ),
+            });
+        }
+        Ok(backup)
+    }
+
+    /// The old file under a temporary name beside it: a hard link (the very bytes, no copy
+    /// to fail half-way), or a synced copy where the filesystem has no links.
+    fn keep_old(&self) -> Result<tempfile::TempPath, Error> {
+        let fail = |e: std::io::Error| Error::Write {
+            path: self.backup_path(),
+            message: format!(
+                "cannot keep the previous version: {e}; {} is unchanged",
+                self.given.display()
+            ),
+        };
+        let slot = crate::output::temp_beside(&self.real, ".blend1")?;
+        std::fs::remove_file(&slot).map_err(fail)?;
+        if std::fs::hard_link(&self.real, &slot).is_err() {
+            let mut from = std::fs::File::open(&self.real).map_err(fail)?;
+            let mut to = std::fs::File::create(&slot).map_err(fail)?;
+            std::io::copy(&mut from, &mut to).map_err(fail)?;
+            to.set_permissions(std::fs::Permissions::from_mode(self.mode))
+                .map_err(fail)?;
+            to.sync_all().map_err(fail)?;
+        }
+        Ok(slot)
+    }
+}
+
+/// Whether a file saved by `saved_by` is newer (by major.minor) than `blender`.
+fn newer(saved_by: BlenderVersion, blender: BlenderVersion) -> bool {
+    (saved_by.major, saved_by.minor) > (blender.major, blender.minor)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(major: u32, minor: u32) -> Option<BlenderVersion> {
+        Some(BlenderVersion { major, minor })
+    }
+
+    #[test]
+    fn both_header_forms_give_the_version() {
+        // The first bytes of files saved by Blender 3.4.1, bpy 4.5 and bpy 5.0 (uncompressed).
+        assert_eq!(parse_version(b"BLENDER-v304RENDH"), v(3, 4));
+        assert_eq!(parse_version(b"BLENDER-v405RENDH"), v(4, 5));
+        assert_eq!(parse_version(b"BLENDER_V279"), v(2, 79));
+        assert_eq!(parse_version(b"BLENDER17-01v0500"), v(5, 0));
+        assert_eq!(parse_version(b"BLENDER17-01v0502"), v(5, 2));
+        assert_eq!(parse_version(b"BLENDER17-01v1203"), v(12, 3));
+    }
+
+    #[test]
+    fn what_is_not_a_header_gives_none() {
+        for bad in [
+            &b""[..],
+            b"BLENDER",
+            b"BLENDER-v4",
+            b"BLENDER-vabc",
+            b"BLENDEX-v405",
+            b"BLENDER17-01v05",
+            b"BLENDER03-01v0500",
+            b"PK\x03\x04",
+        ] {
+            assert_eq!(
+                parse_version(bad),
+                None,
+                "{:?}",
+                String::from_utf8_lossy(bad)
+            );
+        }
+    }
+
+    #[test]
+    fn only_a_newer_major_or_minor_is_newer() {
+        let at = |major, minor| BlenderVersion { major, minor };
+        assert!(newer(at(5, 0), at(4, 5)));
+        assert!(newer(at(4, 5), at(3, 4)));
+        assert!(!newer(at(4, 5), at(4, 5)));
+        assert!(!newer(at(3, 4), at(5, 0)));
+    }
+}
