@@ -572,21 +572,31 @@ fn an_output_pipe_whose_reader_has_gone_is_not_an_error() {
 /// even a temporary file.
 #[test]
 fn sigterm_and_sighup_exit_128_plus_the_signal_and_write_nothing() {
-    for (signal, code) in [(libc::SIGTERM, 143), (libc::SIGHUP, 129), (libc::SIGINT, 130)] {
+    for (signal, code) in [
+        (libc::SIGTERM, 143),
+        (libc::SIGHUP, 129),
+        (libc::SIGINT, 130),
+    ] {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("big.exr");
         let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("gloffuse"))
-            .args(["lut", "--kind", "kulla-conty", "-d", "ggx", "--size", "512", "--out"])
+            .args([
+                "lut",
+                "--kind",
+                "kulla-conty",
+                "-d",
+                "ggx",
+                "--size",
+                "512",
+                "--out",
+            ])
             .arg(&path)
             .stderr(std::process::Stdio::piped())
             .spawn()
             .unwrap();
         std::thread::sleep(std::time::Duration::from_millis(500));
         // SAFETY: kill only sends a signal to the child we spawned.
-        assert_eq!(
-            unsafe { libc::kill(child.id() as libc::pid_t, signal) },
-            0
-        );
+        assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
         let out = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(code), "signal {signal}: {stderr}");

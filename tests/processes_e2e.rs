@@ -95,7 +95,12 @@ fn a_python_driver_does_not_keep_blender_alive() {
             .output()
             .unwrap();
         let took = start.elapsed();
-        assert_eq!(out.status.code(), Some(0), "Blender {label}: {}", text(&out));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "Blender {label}: {}",
+            text(&out)
+        );
         assert!(took < Duration::from_secs(30), "Blender {label}: {took:?}");
         assert_ne!(fs::read(&file).unwrap(), before, "Blender {label}");
         assert!(temporaries_beside(&file).is_empty(), "Blender {label}");
@@ -117,7 +122,12 @@ fn a_folder_named_like_a_traceback_does_not_fail_a_run() {
         driven_blend(&blender, &file);
         let cache = odd.join("cache");
         let out = generate_into(&blender, &file, &cache).output().unwrap();
-        assert_eq!(out.status.code(), Some(0), "Blender {label}: {}", text(&out));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "Blender {label}: {}",
+            text(&out)
+        );
         let runs: Vec<PathBuf> = fs::read_dir(cache.join("gloffuse/runs"))
             .unwrap()
             .map(|e| e.unwrap().path())
@@ -213,7 +223,16 @@ fn with_closed_stdout(args: &[&str], blender: &Path) -> (i32, String) {
 
 /// A small, fast verify sweep; with the seed coefficients GGX at r = 1 is 69 %: a failure.
 const FAILING: [&str; 10] = [
-    "verify", "--coefficients", "seed", "-r", "1", "-d", "ggx", "--spp", "4", "--json",
+    "verify",
+    "--coefficients",
+    "seed",
+    "-r",
+    "1",
+    "-d",
+    "ggx",
+    "--spp",
+    "4",
+    "--json",
 ];
 const PASSING: [&str; 8] = ["verify", "-r", "1", "-d", "ggx", "--spp", "4", "--json"];
 

@@ -162,7 +162,11 @@ pub fn main() -> ExitCode {
         Err(Failure::Library(e @ Error::Interrupted { .. })) => {
             eprintln_quietly(&format!("gloffuse: {e}"));
             let signal = SIGNAL.load(Ordering::SeqCst);
-            ExitCode::from(stopped_code(if signal == 0 { libc::SIGINT } else { signal }))
+            ExitCode::from(stopped_code(if signal == 0 {
+                libc::SIGINT
+            } else {
+                signal
+            }))
         }
         Err(Failure::Library(e)) => {
             eprintln_quietly(&format!("error: {}", chain(&e)));

@@ -235,11 +235,17 @@ mod tests {
         let with_result = format!("{log}GLOFFUSE_RESULT {{\"a\": 3}}\n");
         assert_eq!(check_output(&with_result, ok()).unwrap()["a"], 3);
         let e = check_output(log, ok()).unwrap_err();
-        assert!(e.contains("no result line") && e.contains("ZeroDivisionError"), "{e}");
+        assert!(
+            e.contains("no result line") && e.contains("ZeroDivisionError"),
+            "{e}"
+        );
         let odd = "Read blend: \"/tmp/Traceback (most recent call last)/Error: x.blend\"\n";
         assert!(check_output(&format!("{odd}GLOFFUSE_RESULT {{}}\n"), ok()).is_ok());
         let e = check_output(odd, ExitStatus::from_raw(1 << 8)).unwrap_err();
-        assert!(e.contains("the log ends:") && e.contains("Read blend"), "{e}");
+        assert!(
+            e.contains("the log ends:") && e.contains("Read blend"),
+            "{e}"
+        );
         let e = check_output("a\nb\n", ok()).unwrap_err();
         assert!(e.contains("no result line") && e.contains("\n    b"), "{e}");
         let e = check_output("GLOFFUSE_RESULT {oops\n", ok()).unwrap_err();
