@@ -246,17 +246,29 @@ fn exit_0_without_a_result_line_is_an_error() {
     assert!(log.unwrap().exists());
 }
 
+/// Success is exit 0 and a result line, never words in the log: a traceback Blender printed
+/// for a driver or handler, or a folder named like one, does not fail the run; without the
+/// result line the traceback is quoted.
 #[test]
-fn a_traceback_fails_the_run_even_with_exit_0() {
+fn exit_0_with_a_result_succeeds_whatever_the_log_says() {
     let dir = tempfile::tempdir().unwrap();
+    let noise = "echo 'Traceback (most recent call last):'\necho '  File \"x\", line 1'\necho 'KeyError: 1'\necho 'Error: Traceback (most recent call last)/x.blend'";
     let blender = blender_running(
         dir.path(),
-        "echo 'Traceback (most recent call last):'\necho '  File \"x\", line 1'\necho 'KeyError: 1'\necho 'GLOFFUSE_RESULT {}'",
+        &format!("{noise}\necho 'GLOFFUSE_RESULT {{\"ok\": 1}}'"),
     );
     let script = dir.path().join("x.py");
+    let out = run_script(&run_of(&blender, &script, dir.path(), 30)).unwrap();
+    assert_eq!(out.result, serde_json::json!({"ok": 1}));
+
+    let quiet = tempfile::tempdir().unwrap();
+    let blender = blender_running(quiet.path(), noise);
     let (message, _, _) =
-        blender_error(run_script(&run_of(&blender, &script, dir.path(), 30)).unwrap_err());
-    assert!(message.contains("KeyError: 1"), "{message}");
+        blender_error(run_script(&run_of(&blender, &script, quiet.path(), 30)).unwrap_err());
+    assert!(
+        message.contains("no result line") && message.contains("KeyError: 1"),
+        "{message}"
+    );
 }
 
 #[test]

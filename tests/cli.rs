@@ -540,3 +540,68 @@ fn lut_bad_input_exits_2_and_writes_nothing() {
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
+
+/// A pipe whose reader has gone, named as an output (`--out /dev/stdout | true`, or
+/// `/proc/self/fd/1`), is no error, the same as `--out -`: the command's own outcome (0)
+/// stands, and the summary (on stderr, as the output is stdout) is printed whole.
+#[test]
+fn an_output_pipe_whose_reader_has_gone_is_not_an_error() {
+    use std::os::fd::{FromRawFd, OwnedFd};
+    for out in ["-", "/dev/stdout", "/proc/self/fd/1"] {
+        let mut fds = [0; 2];
+        // SAFETY: pipe() fills two new descriptors; each is owned exactly once below.
+        assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+        let (reader, writer) =
+            unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) };
+        drop(reader);
+        let run = std::process::Command::new(assert_cmd::cargo::cargo_bin("gloffuse"))
+            .args(["lut", "--kind", "kulla-conty", "-d", "ggx", "--size", "8"])
+            .args(["--samples", "64", "--format", "exr", "--out", out])
+            .stdout(writer)
+            .output()
+            .expect("gloffuse starts");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(0), "--out {out}: {stderr}");
+        assert!(stderr.contains(&format!("wrote {out} (")), "{stderr}");
+        assert!(!stderr.contains("error"), "--out {out}: {stderr}");
+    }
+}
+
+/// SIGTERM and SIGHUP (`timeout`, a CI cancel, a closed terminal) while no Blender runs
+/// stop the command at once like Ctrl-C: exit 128 + the signal, and nothing written, not
+/// even a temporary file.
+#[test]
+fn sigterm_and_sighup_exit_128_plus_the_signal_and_write_nothing() {
+    for (signal, code) in [
+        (libc::SIGTERM, 143),
+        (libc::SIGHUP, 129),
+        (libc::SIGINT, 130),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.exr");
+        let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("gloffuse"))
+            .args([
+                "lut",
+                "--kind",
+                "kulla-conty",
+                "-d",
+                "ggx",
+                "--size",
+                "512",
+                "--out",
+            ])
+            .arg(&path)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(500));
+        // SAFETY: kill only sends a signal to the child we spawned.
+        assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "signal {signal}: {stderr}");
+        assert!(stderr.contains("nothing was written"), "{stderr}");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "signal {signal}: {left:?}");
+    }
+}

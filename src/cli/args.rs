@@ -32,7 +32,9 @@ Exit codes: 0 success; 1 a check failed (verify, refresh); 2 an error: bad input
 names the flag or file and what would be right), no Blender found (it says where gloffuse \
 looked and how to point at one), Blender failed or timed out (the message quotes its log, \
 names the log file and prints the command to rerun it), or an output could not be written \
-(nothing half-written is ever left behind).";
+(nothing half-written is ever left behind); 128 + the signal when stopped (130 Ctrl-C, 143 \
+SIGTERM, 129 SIGHUP; Blender is stopped, nothing is written). A closed stdout (| head) keeps \
+the command's own exit code.";
 
 const GENERATE_EXAMPLES: &str = "\
 Examples:

@@ -1,8 +1,20 @@
 //! The binary's edge: parse the command line, call the library, print what it returns, and
 //! map the outcome to an exit code. Nothing below this module parses flags or prints.
 //!
-//! Exit codes: 0 success, 1 a check failed, 2 an error, 130 interrupted (Ctrl-C). A closed
-//! stdout (`gloffuse … | head`) ends the program quietly with 0, as ripgrep does.
+//! Exit codes, one rule each:
+//!
+//! - 0: the command succeeded (for `verify` and `refresh`: every sphere passed);
+//! - 1: a check failed (`verify` or `refresh` found a sphere outside its tolerance);
+//! - 2: an error (bad input, Blender failed, an output could not be written);
+//! - 128 + the signal's number when stopped by a signal: 130 for Ctrl-C (SIGINT), 143 for
+//!   SIGTERM (`timeout`, a CI cancel), 129 for SIGHUP. Blender is stopped and nothing is
+//!   written: no output, no temporary file beside one.
+//!
+//! A closed stdout (`gloffuse … | head`, `| true`, `grep -q`) is not an outcome: what would
+//! have been printed is dropped quietly and the exit code is the command's own, so a failing
+//! verdict still exits 1 under `set -o pipefail`. The same holds for an output that is a pipe
+//! (`--out -`, `--out /dev/stdout`). SIGPIPE stays ignored (Rust's default), so a write to a
+//! closed pipe is an error we see (EPIPE), never a silent death.
 
 mod args;
 mod progress;
@@ -13,6 +25,7 @@ use std::io::{self, Write};
 use std::path::Path;
 use std::process::ExitCode;
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicI32, Ordering};
 
 use args::{AlbedoArgs, Cli, CoefficientsCommand, Command, FitArgs};
 use gloffuse::Error;
@@ -33,7 +46,7 @@ enum Outcome {
 /// Why a command did not end normally.
 enum Failure {
     Library(Error),
-    /// Writing to stdout failed (a closed pipe is not a failure; see [`main`]).
+    /// Writing to stdout failed (a closed pipe is not a failure; see [`Printed`]).
     Stdout(io::Error),
 }
 
@@ -51,39 +64,90 @@ impl From<io::Error> for Failure {
 
 type Result<T> = std::result::Result<T, Failure>;
 
-/// What Ctrl-C stops: every command's Blender options carry a clone of it.
+/// What Ctrl-C, SIGTERM and SIGHUP stop: every command's Blender options carry a clone of it.
 static CANCEL: OnceLock<Cancel> = OnceLock::new();
+
+/// The signal that stopped the command (0: none yet), for its exit code.
+static SIGNAL: AtomicI32 = AtomicI32::new(0);
+
+/// The signals that stop a command, each handled like Ctrl-C.
+const STOP_SIGNALS: [libc::c_int; 3] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP];
 
 fn cancel() -> &'static Cancel {
     CANCEL.get_or_init(Cancel::default)
 }
 
-/// Ctrl-C: while a Blender run is waited for, ask the library to stop it (the run then
-/// fails with `Error::Interrupted`, nothing is written, and `main` exits 130); otherwise end
-/// at once. Only async-signal-safe calls here (`main` made the handle before installing this).
-extern "C" fn on_interrupt(_: libc::c_int) {
-    // With a child waited for, its wait loop stops it and the command ends with 130.
+/// The exit code of a command stopped by `signal`: 128 + its number, as shells report it.
+fn stopped_code(signal: libc::c_int) -> u8 {
+    u8::try_from(128 + signal).unwrap_or(130)
+}
+
+/// A stop signal: while a Blender run is waited for, ask the library to stop it (the run then
+/// fails with `Error::Interrupted`, its temporary files are dropped, nothing is written, and
+/// `main` exits 128 + the signal); otherwise end at once, as nothing is half-written outside
+/// a run. Only async-signal-safe calls here (`main` made the handle before installing this).
+extern "C" fn on_signal(signal: libc::c_int) {
+    // The first signal names the exit code.
+    let _ = SIGNAL.compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst);
     if !CANCEL.get().is_some_and(Cancel::request) {
-        let message = b"\ngloffuse: interrupted; nothing was written\n";
+        let message = b"\ngloffuse: stopped; nothing was written\n";
         // SAFETY: write and _exit are async-signal-safe.
         unsafe {
             libc::write(2, message.as_ptr().cast(), message.len());
-            libc::_exit(130);
+            libc::_exit(i32::from(stopped_code(SIGNAL.load(Ordering::SeqCst))));
         }
+    }
+}
+
+/// Standard output or error, where a reader that has gone away (EPIPE) ends the printing
+/// and not the command: later writes are dropped, and the command's outcome stands.
+struct Printed<W: Write> {
+    inner: W,
+    closed: bool,
+}
+
+impl<W: Write> Printed<W> {
+    fn new(inner: W) -> Self {
+        Printed {
+            inner,
+            closed: false,
+        }
+    }
+
+    fn guard<T>(&mut self, done: T, write: impl FnOnce(&mut W) -> io::Result<T>) -> io::Result<T> {
+        if self.closed {
+            return Ok(done);
+        }
+        match write(&mut self.inner) {
+            Err(e) if e.kind() == io::ErrorKind::BrokenPipe => {
+                self.closed = true;
+                Ok(done)
+            }
+            other => other,
+        }
+    }
+}
+
+impl<W: Write> Write for Printed<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.guard(buf.len(), |w| w.write(buf))
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.guard((), Write::flush)
     }
 }
 
 pub fn main() -> ExitCode {
     cancel();
-    // SAFETY: installs a handler that only touches atomics and calls write/_exit.
-    unsafe {
-        libc::signal(
-            libc::SIGINT,
-            on_interrupt as *const () as libc::sighandler_t,
-        );
+    for signal in STOP_SIGNALS {
+        // SAFETY: installs a handler that only touches atomics and calls write/_exit.
+        unsafe {
+            libc::signal(signal, on_signal as *const () as libc::sighandler_t);
+        }
     }
     let cli = Cli::parse();
-    let mut out = io::stdout().lock();
+    let mut out = Printed::new(io::stdout().lock());
     let outcome = run(cli, &mut out).and_then(|o| {
         out.flush()?;
         Ok(o)
@@ -91,14 +155,18 @@ pub fn main() -> ExitCode {
     match outcome {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
-        Err(Failure::Stdout(e)) if e.kind() == io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
         Err(Failure::Stdout(e)) => {
             eprintln_quietly(&format!("error: cannot write to standard output: {e}"));
             ExitCode::from(2)
         }
         Err(Failure::Library(e @ Error::Interrupted { .. })) => {
             eprintln_quietly(&format!("gloffuse: {e}"));
-            ExitCode::from(130)
+            let signal = SIGNAL.load(Ordering::SeqCst);
+            ExitCode::from(stopped_code(if signal == 0 {
+                libc::SIGINT
+            } else {
+                signal
+            }))
         }
         Err(Failure::Library(e)) => {
             eprintln_quietly(&format!("error: {}", chain(&e)));
@@ -135,7 +203,7 @@ fn summary<'a>(
 
 fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
     let terminal = Terminal::default();
-    let mut stderr = io::stderr();
+    let mut stderr = Printed::new(io::stderr());
     match cli.command {
         Command::Albedo(a) => albedo(&a, out, &terminal),
         Command::Fit(f) => {

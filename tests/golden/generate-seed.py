@@ -1901,10 +1901,12 @@ def sphere_mesh(name, radius, segments, rings, cut_below=None):
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
 #   open_blend(path), save_blend(path, compress) -> absolute path
 #   result_line(payload) -> "GLOFFUSE_RESULT {...}"
-#   run_main(main) -> runs main with the error handling described there
+#   run_main(main) -> runs main with the error handling described there, and
+#       ends the process when main is done (see end_process)
 # ---------------------------------------------------------------------------
 import argparse
 import os
+import shutil
 import sys
 import traceback
 
@@ -1986,26 +1988,48 @@ def result_line(payload):
     return "GLOFFUSE_RESULT " + json.dumps(payload, sort_keys=True)
 
 
+def end_process(code):
+    """End a headless job with exit status `code`, its output flushed.
+
+    Under the bpy module the process ends at once (os._exit): the interpreter's
+    normal exit runs Blender's shutdown, which can hang for good (bpy 4.5 with
+    a Python-evaluated driver in the open file), and by now the files are
+    saved and the result line printed, so nothing is left to do but remove
+    Blender's session temp folder, as its shutdown would. The blender binary
+    quits by itself once the script returns, cleaning up after itself; an
+    error there exits with `code`."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if running_in_blender_binary():
+        if code:
+            sys.exit(code)
+        return
+    session = os.path.normpath(bpy.app.tempdir or "")
+    if os.path.basename(session).startswith("blender_"):
+        shutil.rmtree(session, ignore_errors=True)
+    os._exit(code)
+
+
 def run_main(main):
-    """Run main(); on error print the traceback and, headless, exit 1 (2 for
-    bad arguments), because blender -b --python ignores exceptions unless
+    """Run main() and end the process (end_process: at once under the bpy
+    module). On error print the traceback and, headless, exit 1 (2 for bad
+    arguments), because blender -b --python ignores exceptions unless
     --python-exit-code is given. Interactive (Text Editor) the exception is
     re-raised so Blender shows it and keeps running."""
     try:
         main()
     except ArgumentError as error:
         sys.stderr.write("%s\n" % error)
-        sys.stderr.flush()
         if bpy.app.background:
-            sys.exit(2)
+            end_process(2)
         raise
     except Exception:
         traceback.print_exc()
-        sys.stderr.flush()
         if bpy.app.background:
-            sys.stdout.flush()
-            sys.exit(1)
+            end_process(1)
         raise
+    if bpy.app.background:
+        end_process(0)
 
 
 def render_result_image():

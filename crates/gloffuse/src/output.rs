@@ -115,28 +115,29 @@ pub fn is_stdout(path: &Path) -> bool {
     }
 }
 
-/// Writes `bytes` to `path` as [`check_destination`] says. A closed standard output is not
-/// an error (the reader has seen enough).
+/// Writes `bytes` to `path` as [`check_destination`] says. A pipe whose reader has gone
+/// (`-` or `/dev/stdout` piped into `head`, a FIFO whose reader quit) is not an error: the
+/// reader has seen enough, and the command's own outcome stands.
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    match check_destination(path)? {
+    let written = match check_destination(path)? {
         Destination::Stdout => {
             let mut out = std::io::stdout().lock();
-            match out.write_all(bytes).and_then(|()| out.flush()) {
-                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-                    Err(fail(path, e.to_string()))
-                }
-                _ => Ok(()),
-            }
+            out.write_all(bytes).and_then(|()| out.flush())
         }
         Destination::Stream(p) => std::fs::OpenOptions::new()
             .write(true)
             .open(&p)
-            .and_then(|mut f| f.write_all(bytes))
-            .map_err(|e| fail(path, e.to_string())),
-        Destination::File(real) => write_atomic(&real, bytes).map_err(|e| match e {
-            Error::Write { message, .. } => fail(path, message),
-            other => other,
-        }),
+            .and_then(|mut f| f.write_all(bytes)),
+        Destination::File(real) => {
+            return write_atomic(&real, bytes).map_err(|e| match e {
+                Error::Write { message, .. } => fail(path, message),
+                other => other,
+            });
+        }
+    };
+    match written {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(fail(path, e.to_string())),
+        _ => Ok(()),
     }
 }
 

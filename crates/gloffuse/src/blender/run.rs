@@ -5,6 +5,11 @@
 //! The script reports by printing one line `GLOFFUSE_RESULT {json}` to stdout; the last such
 //! line wins. Write it in one call and flush, so Blender's own output cannot split it:
 //! `sys.stdout.write("GLOFFUSE_RESULT " + json.dumps(result) + "\n"); sys.stdout.flush()`.
+//!
+//! A run succeeds when it exits 0 and printed a result line, and only then: the log is
+//! never searched for words to decide (Blender prints tracebacks of drivers and handlers
+//! that do not fail the job, and any path may hold any words). A traceback is looked for
+//! only to quote it when a run has failed.
 
 use super::probe::{Blender, BlenderKind};
 use super::process::{Cancel, Exit, describe_status, format_seconds, run_logged, shell_join};
@@ -18,8 +23,8 @@ use std::time::{Duration, Instant};
 /// The prefix of the stdout line that carries a script's result as JSON.
 pub const RESULT_PREFIX: &str = "GLOFFUSE_RESULT ";
 
-/// The line Python prints at the start of an uncaught exception's traceback.
-const TRACEBACK: &str = "Traceback (most recent call last)";
+/// The line Python prints, alone, at the start of an exception's traceback.
+const TRACEBACK: &str = "Traceback (most recent call last):";
 
 /// How many lines of a traceback, or of the end of the log, an error quotes.
 const TRACEBACK_LINES: usize = 8;
@@ -85,8 +90,8 @@ pub fn command_line(run: &Run) -> String {
 /// Runs the script, waits at most `run.timeout`, and reads its result back.
 ///
 /// Errors ([`Error::Blender`], naming the log and the command): Blender cannot be started,
-/// it times out (its whole process group is killed), it exits non-zero, its log holds a
-/// Python traceback, or it prints no parseable `GLOFFUSE_RESULT` line.
+/// it times out (its whole process group is killed), it exits non-zero, or it prints no
+/// parseable `GLOFFUSE_RESULT` line.
 pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
     let argv = argv(run);
     let command = shell_join(&argv);
@@ -137,28 +142,22 @@ pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
         seconds,
     })
 }
-/// Decides whether a finished run succeeded, from its exit status and its log; on failure
-/// the message quotes the lines that say why.
+/// Decides whether a finished run succeeded, from its exit status and its result line alone;
+/// on failure the message quotes the lines that say why (its last traceback, else the end
+/// of the log).
 fn check_output(text: &str, status: ExitStatus) -> Result<serde_json::Value, String> {
     let lines: Vec<&str> = text.lines().collect();
-    let traceback = last_traceback(&lines);
     let quote = |what: &[&str]| -> String {
         what.iter()
             .map(|l| format!("\n    {}", clip(l, 300)))
             .collect()
     };
+    let why = || match last_traceback(&lines) {
+        Some(tb) => format!("its Python script raised:{}", quote(tb)),
+        None => format!("the log ends:{}", quote(tail(&lines))),
+    };
     if !status.success() {
-        let why = describe_status(status);
-        return Err(match traceback {
-            Some(tb) => format!("Blender {why}; its Python script raised:{}", quote(tb)),
-            None => format!("Blender {why}; the log ends:{}", quote(tail(&lines))),
-        });
-    }
-    if let Some(tb) = traceback {
-        return Err(format!(
-            "Blender exited 0 but its log holds a Python traceback:{}",
-            quote(tb)
-        ));
+        return Err(format!("Blender {}; {}", describe_status(status), why()));
     }
     let Some(line) = lines
         .iter()
@@ -166,9 +165,8 @@ fn check_output(text: &str, status: ExitStatus) -> Result<serde_json::Value, Str
         .find_map(|l| l.trim_end().strip_prefix(RESULT_PREFIX))
     else {
         return Err(format!(
-            "Blender exited 0 but printed no result line ({}{{…}}); the log ends:{}",
-            RESULT_PREFIX,
-            quote(tail(&lines))
+            "Blender exited 0 but printed no result line ({RESULT_PREFIX}{{…}}); {}",
+            why()
         ));
     };
     serde_json::from_str(line).map_err(|e| {
@@ -182,7 +180,7 @@ fn check_output(text: &str, status: ExitStatus) -> Result<serde_json::Value, Str
 /// The last traceback in the log, from its `Traceback` line to the exception line (the
 /// first unindented line after it), cut to its last [`TRACEBACK_LINES`] lines.
 fn last_traceback<'t>(lines: &'t [&'t str]) -> Option<&'t [&'t str]> {
-    let start = lines.iter().rposition(|l| l.contains(TRACEBACK))?;
+    let start = lines.iter().rposition(|l| l.trim_end() == TRACEBACK)?;
     let end = lines[start + 1..]
         .iter()
         .position(|l| !l.is_empty() && !l.starts_with([' ', '\t']))
@@ -232,12 +230,21 @@ mod tests {
         assert!(e.contains("exited with status 1"), "{e}");
         assert!(e.contains("ZeroDivisionError"), "{e}");
         assert!(!e.contains("Blender quit"), "{e}");
-        // A traceback fails the run even with exit status 0.
-        let with_result = format!("{log}GLOFFUSE_RESULT {{}}\n");
+        // Exit 0 with a result line succeeds whatever the log says (a driver's traceback,
+        // a folder named like one); without a result line the traceback is quoted.
+        let with_result = format!("{log}GLOFFUSE_RESULT {{\"a\": 3}}\n");
+        assert_eq!(check_output(&with_result, ok()).unwrap()["a"], 3);
+        let e = check_output(log, ok()).unwrap_err();
         assert!(
-            check_output(&with_result, ok())
-                .unwrap_err()
-                .contains("traceback")
+            e.contains("no result line") && e.contains("ZeroDivisionError"),
+            "{e}"
+        );
+        let odd = "Read blend: \"/tmp/Traceback (most recent call last)/Error: x.blend\"\n";
+        assert!(check_output(&format!("{odd}GLOFFUSE_RESULT {{}}\n"), ok()).is_ok());
+        let e = check_output(odd, ExitStatus::from_raw(1 << 8)).unwrap_err();
+        assert!(
+            e.contains("the log ends:") && e.contains("Read blend"),
+            "{e}"
         );
         let e = check_output("a\nb\n", ok()).unwrap_err();
         assert!(e.contains("no result line") && e.contains("\n    b"), "{e}");
@@ -253,7 +260,7 @@ mod tests {
             log.push_str(&format!("  File \"f{i}.py\", line {i}\n"));
         }
         log.push_str("KeyError: 'x'\nafter\n");
-        let e = check_output(&log, ok()).unwrap_err();
+        let e = check_output(&log, ExitStatus::from_raw(1 << 8)).unwrap_err();
         assert_eq!(e.matches("\n    ").count(), TRACEBACK_LINES);
         assert!(e.contains("KeyError") && !e.contains("f0.py") && !e.contains("after"));
     }

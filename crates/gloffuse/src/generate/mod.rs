@@ -17,7 +17,7 @@ pub use script::{Job, assemble, assemble_with_main};
 
 use serde::Serialize;
 use std::ffi::OsString;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::blender::{Blender, BlenderOptions, Run, command_line, run_script};
 use crate::error::{Error, Field, Hint};
@@ -387,7 +387,8 @@ fn run_blender(
         cancel: g.blender.cancel.clone(),
         log: log.clone(),
     };
-    run_script(&run)?;
+    // A run stopped while Blender saved leaves its partial `NAME@` beside the temp name.
+    run_script(&run).inspect_err(|_| remove_partial_save(&tmp))?;
     if let Some(why) = incomplete_blend(&tmp) {
         return Err(Error::Blender {
             message: format!("Blender reported success but {why}").into(),
@@ -401,6 +402,13 @@ fn run_blender(
         target,
         log,
     })
+}
+
+/// Removes what Blender writes before renaming it to `saved` (`saved@`), if it is there.
+fn remove_partial_save(saved: &Path) {
+    let mut partial = saved.as_os_str().to_owned();
+    partial.push("@");
+    let _ = std::fs::remove_file(partial);
 }
 
 /// The extension's .zip in memory, if one is asked for: the saved .blend and its catalogs.
