@@ -546,6 +546,11 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "OUT.blend", conflicts_with = "into")]
     pub blend: Option<PathBuf>,
 
+    /// Let --blend replace an existing .blend that is not a gloffuse library (a scene, or a
+    /// library made before gloffuse marked its libraries). Without it such a file is refused.
+    #[arg(long, requires = "blend")]
+    pub force: bool,
+
     /// Add or replace the groups in an existing .blend, in place (materials using them keep
     /// working); the previous file is kept as FILE.blend1.
     #[arg(long, value_name = "EXISTING.blend")]
@@ -592,6 +597,7 @@ impl GenerateArgs {
             script: self.script.clone(),
             blend: self.blend.clone(),
             into: self.into.clone(),
+            force: self.force,
             extension: self.extension.clone(),
             modes: self.mode.clone(),
             engines: self.engine.clone(),
@@ -896,6 +902,7 @@ pub fn flag(field: Field) -> String {
         Field::Distribution => "--distribution",
         Field::Engine => "--engine",
         Field::Extension => "--extension",
+        Field::Force => "--force",
         Field::Format => "--format",
         Field::GModel => "--g-model",
         Field::Into => "--into",
@@ -917,6 +924,7 @@ pub fn flag(field: Field) -> String {
         Field::Timeout => "--timeout",
         Field::ViewCosine => "--mu",
         Field::Arguments
+        | Field::Catalogs
         | Field::ContactSheet
         | Field::ModelParameter(_)
         | Field::PointRoughness
