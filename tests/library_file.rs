@@ -22,9 +22,9 @@ fn user_file_script() -> &'static Path {
 /// A user's scene (a cube, the material "Chair Paint", and with `group` their own local
 /// node group of that name used by the material), saved by `blender` at `path`.
 fn make_user_file(blender: &Path, path: &Path, group: Option<&str>) {
-    let mut args = vec!["--make".as_ref(), path.as_os_str()];
+    let mut args: Vec<&std::ffi::OsStr> = vec!["--make".as_ref(), path.as_os_str()];
     if let Some(group) = group {
-        args.extend(["--group".as_ref(), group.as_ref()]);
+        args.extend::<[&std::ffi::OsStr; 2]>(["--group".as_ref(), group.as_ref()]);
     }
     let run = common::blender::run_in_blender(blender, user_file_script(), &args);
     assert!(
