@@ -10,15 +10,15 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-/// tests/blender/user_file.py run in `blender` with `args`; its result line, parsed.
+/// tests/blender/user_blend.py run in `blender` with `args`; its result line, parsed.
 fn user_file(blender: &Path, args: &[&str]) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/user_file.py");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/user_blend.py");
     let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
     let out = common::blender::run_in_blender(blender, &script, &args);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
-        "user_file.py {args:?} failed\nstdout:\n{stdout}\nstderr:\n{}",
+        "user_blend.py {args:?} failed\nstdout:\n{stdout}\nstderr:\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
     stdout

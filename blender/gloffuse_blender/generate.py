@@ -6,7 +6,9 @@
 #   blender -b --factory-startup -noaudio --python-exit-code 1 --python THIS.py -- [--open IN.blend] [--save OUT.blend]
 #   python3 THIS.py [--open IN.blend] [--save OUT.blend]      (with the bpy module)
 #
-# Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
+# Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...],
+# "renamed": [[yours, now], ...], "saved": ...}, or {"refused": why, ...} when
+# --replace-library names a file that is not a gloffuse library (nothing saved).
 # The job module of the generate script: the gloffuse binary bundles it with
 # the modules it imports, after the header that defines GLOFFUSE_PARAMS (the
 # parameter document as a JSON string), and ends the script with
@@ -18,7 +20,8 @@ import tempfile
 import bpy
 
 from .compat import blender_version_string
-from .groups import build_all
+from .groups import build_all, group_names, library_contents, mark_library
+from .nodes import set_aside_untagged
 from .params import load_params
 from .previews import render_previews
 from .runtime import (
@@ -41,19 +44,34 @@ def parse_generate_args(argv=None):
                         help="save the result as this .blend file (default: do not save)")
     parser.add_argument("--compress", action="store_true",
                         help="save compressed (as the file opened was)")
+    parser.add_argument("--replace-library", metavar="OLD.blend",
+                        help="the library the new one replaces: refuse (save nothing) unless "
+                             "it carries the gloffuse library marker")
     return parse_script_args(parser, argv)
 
 
 def generate_main(document_text):
     options = parse_generate_args()
     params = load_params(document_text)
+    if options.replace_library:
+        open_blend(options.replace_library)
+        refused = library_contents()
+        if refused is not None:
+            print(result_line({"blender_version": blender_version_string(),
+                               "refused": refused, "saved": None}))
+            sys.stdout.flush()
+            return
+    new_library = not options.open and options.save and bpy.app.background
     if options.open:
         open_blend(options.open)
-    elif options.save and bpy.app.background:
+    elif new_library:
         # A new library file holds the groups and nothing else: not the startup
         # file's cube, camera and light.
         bpy.ops.wm.read_factory_settings(use_empty=True)
+    renamed = set_aside_untagged(group_names(params))
     built = build_all(params)
+    if new_library:
+        mark_library(params)
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
             render_previews(built, directory)
@@ -64,6 +82,7 @@ def generate_main(document_text):
     print(result_line({
         "blender_version": blender_version_string(),
         "groups": names,
+        "renamed": renamed,
         "saved": saved,
     }))
     sys.stdout.flush()

@@ -4,14 +4,34 @@
 #
 # A module of the gloffuse_blender package. Functions only.
 #
+#   group_names(params) -> every group name build_all builds
 #   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
 #                                                     params.py's resolve_params)
+#   mark_library(params), library_contents() -> the marker of a gloffuse library
 # ---------------------------------------------------------------------------
 from .layered_groups import build_layered_group
+import bpy
+
+from .nodes import GLOFFUSE_TAG, is_tagged
 from .normal_group import build_normal_group
 from .params import validate_params
 from .roughness_groups import build_correction_group, build_shader_group
 from .view_groups import build_multiscatter_group, build_view_correction_group, build_view_shader_group
+
+
+def group_names(params):
+    """Every node group name build_all(params) builds, in the order it builds them."""
+    names = []
+    for spec in params["groups"]:
+        view = spec.get("view") or {}
+        layered = spec.get("layered") or {}
+        for name in (spec.get("normal_group") if view or layered else None,
+                     spec["correction_group"], spec["shader_group"],
+                     view.get("correction_group"), view.get("shader_group"),
+                     view.get("multiscatter_group"), layered.get("shader_group")):
+            if name is not None and name not in names:
+                names.append(name)
+    return names
 
 
 def build_all(params):
@@ -43,4 +63,30 @@ def build_all(params):
         if spec.get("layered"):
             trees.append(build_layered_group(spec, params))
         built.append((spec, trees))
+    names = group_names(params)
+    for _spec, trees in built:
+        for tree in trees:
+            if tree.name not in names:
+                raise ValueError("group_names misses the group %r it must set aside" % tree.name)
+            tree[GLOFFUSE_TAG] = params.get("gloffuse_version", "")
     return built
+
+
+def mark_library(params):
+    """Mark the open file as a gloffuse library: its scenes carry the tag (the
+    version). generate --blend replaces only a file that has it."""
+    for scene in bpy.data.scenes:
+        scene[GLOFFUSE_TAG] = params.get("gloffuse_version", "")
+
+
+def library_contents():
+    """None if the open file is a gloffuse library (a scene carries the tag),
+    else what it holds instead, in words."""
+    if any(is_tagged(scene) for scene in bpy.data.scenes):
+        return None
+    counts = [(len(bpy.data.objects), "object"), (len(bpy.data.materials), "material"),
+              (len(bpy.data.meshes), "mesh"), (len(bpy.data.node_groups), "node group"),
+              (len(bpy.data.images), "image")]
+    held = ["%d %s%s" % (n, what, "" if n == 1 else "es" if what == "mesh" else "s")
+            for n, what in counts if n]
+    return "no gloffuse library marker; it holds %s" % (", ".join(held) or "nothing")

@@ -123,12 +123,45 @@ def gain_at(curve, roughness):
 # Building the groups
 # ---------------------------------------------------------------------------
 
+# The custom property that marks a node group (and a library's scene) as made
+# by gloffuse; its value is the gloffuse version. Only tagged groups are ever
+# rebuilt: a group of the same name without it is the user's own.
+GLOFFUSE_TAG = "gloffuse"
+
+
+def is_tagged(id_block):
+    return GLOFFUSE_TAG in id_block.keys()
+
+
+def set_aside_untagged(names):
+    """Rename every local node group called one of `names` that carries no
+    gloffuse tag (the user's own, or one made before tagging) to a free name,
+    "NAME (yours)" (Blender adds .001 etc. if that is taken). Renaming keeps
+    the datablock, so every material using it still does. Returns
+    [[old name, new name], ...]."""
+    renamed = []
+    for tree in list(bpy.data.node_groups):
+        if tree.library is not None or tree.name not in names or is_tagged(tree):
+            continue
+        old = tree.name
+        tree.name = old + " (yours)"
+        if tree.name in names or tree.name == old:
+            raise ValueError("could not rename your node group %r out of the way; rename "
+                             "it and run again" % old)
+        renamed.append([old, tree.name])
+    return renamed
+
+
 def reuse_or_create_group(name):
     """The local ShaderNodeTree called `name`, emptied of nodes, or a new one.
     Reusing the datablock keeps every material that uses it working (no
-    ".001" copy, same pointer)."""
+    ".001" copy, same pointer). Untagged groups must have been set aside
+    first (set_aside_untagged): one left here is refused, never emptied."""
     for tree in bpy.data.node_groups:
         if tree.name == name and tree.library is None:
+            if not is_tagged(tree):
+                raise ValueError("the node group %r was not made by gloffuse and was not "
+                                 "set aside" % name)
             if tree.bl_idname != "ShaderNodeTree":
                 raise ValueError("a node group called %r already exists but is a %s, "
                                  "not a shader node group; rename it and run again"
@@ -138,6 +171,8 @@ def reuse_or_create_group(name):
     tree = bpy.data.node_groups.new(name, "ShaderNodeTree")
     if tree.name != name:
         raise ValueError("Blender renamed the new node group %r to %r" % (name, tree.name))
+    # Tagged at once (build_all writes the version), so a rebuild in this run reuses it.
+    tree[GLOFFUSE_TAG] = ""
     return tree
 
 

@@ -548,6 +548,11 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "OUT.blend", conflicts_with = "into")]
     pub blend: Option<PathBuf>,
 
+    /// Let --blend replace an existing .blend that is not a gloffuse library (a scene, or a
+    /// library made before gloffuse marked its libraries). Without it such a file is refused.
+    #[arg(long, requires = "blend")]
+    pub force: bool,
+
     /// Add or replace the groups in an existing .blend, in place (materials using them keep
     /// working); the previous file is kept as FILE.blend1.
     #[arg(long, value_name = "EXISTING.blend")]
@@ -601,6 +606,7 @@ impl GenerateArgs {
             blend: self.blend.clone(),
             into: self.into.clone(),
             allow_downgrade: self.allow_downgrade,
+            force: self.force,
             extension: self.extension.clone(),
             modes: self.mode.clone(),
             engines: self.engine.clone(),
@@ -905,6 +911,7 @@ pub fn flag(field: Field) -> String {
         Field::Distribution => "--distribution",
         Field::Engine => "--engine",
         Field::Extension => "--extension",
+        Field::Force => "--force",
         Field::Format => "--format",
         Field::GModel => "--g-model",
         Field::Into => "--into",
@@ -927,6 +934,7 @@ pub fn flag(field: Field) -> String {
         Field::Timeout => "--timeout",
         Field::ViewCosine => "--mu",
         Field::Arguments
+        | Field::Catalogs
         | Field::ContactSheet
         | Field::ModelParameter(_)
         | Field::PointRoughness

@@ -36,6 +36,14 @@ pub fn generated(out: &Generated) -> String {
     }
     let _ = writeln!(s, "coefficients: {}", out.coefficients);
     let _ = writeln!(s, "groups: {}", out.groups.join(", "));
+    for r in &out.renamed {
+        let _ = writeln!(
+            s,
+            "renamed: your group '{}' (not made by gloffuse) is now '{}'; materials using it \
+             still do",
+            r.group, r.renamed_to
+        );
+    }
     s
 }
 

@@ -1,61 +1,101 @@
-# ---------------------------------------------------------------------------
-# user_file.py: makes and reads back "a user's own .blend" for tests/user_blend.rs.
-#
-#   make OUT.blend [--compress] [--texture]   a cube with a material; with
-#       --texture, an Image Texture node whose image is the relative path
-#       //tex.png (the test puts tex.png beside OUT.blend)
-#   inspect IN.blend                          prints one line
-#       GLOFFUSE_RESULT {"version": [major, minor, patch], "images": {name: filepath},
-#                        "groups": [names], "materials": [names]}
-# ---------------------------------------------------------------------------
+"""A user's own .blend for tests/library_file.rs, made and inspected inside
+real Blender, independently of gloffuse's package.
+
+    blender -b --factory-startup -noaudio --python-exit-code 1 --python user_file.py -- \
+        --make OUT.blend [--group NAME]
+    blender ... --python user_file.py -- --inspect IN.blend --out RESULT.json
+    python3 user_file.py ...   (bpy module)
+
+--make saves a scene as an artist has it: a cube with the material
+"Chair Paint"; with --group, that material uses the user's own local node
+group NAME (a Value node "user value" = 0.123 wired to its output).
+--inspect writes what the file holds: every local node group (its gloffuse
+tag, its node names), every material with the groups its nodes use, the
+scenes' gloffuse tags, and the number of objects.
+"""
 import argparse
 import json
 import sys
+import traceback
 
 import bpy
 
 
 def args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
-    parser = argparse.ArgumentParser(prog="user_file")
-    parser.add_argument("action", choices=["make", "inspect"])
-    parser.add_argument("path")
-    parser.add_argument("--compress", action="store_true")
-    parser.add_argument("--texture", action="store_true")
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--make")
+    parser.add_argument("--group")
+    parser.add_argument("--inspect")
+    parser.add_argument("--out")
     return parser.parse_args(argv)
 
 
-def make(path, compress, texture):
+def user_group(name):
+    tree = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    if hasattr(tree, "interface"):
+        tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")
+    else:
+        tree.outputs.new("NodeSocketFloat", "Value")
+    value = tree.nodes.new("ShaderNodeValue")
+    value.name = "user value"
+    value.outputs[0].default_value = 0.123
+    output = tree.nodes.new("NodeGroupOutput")
+    tree.links.new(value.outputs[0], output.inputs[0])
+    return tree
+
+
+def make(path, group):
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.mesh.primitive_cube_add()
-    material = bpy.data.materials.new("User Material")
-    material.use_nodes = True
-    if texture:
-        image = bpy.data.images.new("tex", 4, 4)
-        image.source = "FILE"
-        image.filepath = "//tex.png"
-        node = material.node_tree.nodes.new("ShaderNodeTexImage")
-        node.image = image
-    bpy.context.object.data.materials.append(material)
-    bpy.ops.wm.save_as_mainfile(filepath=path, compress=compress, relative_remap=False)
+    mesh = bpy.data.meshes.new("Cube")
+    corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    mesh.from_pydata(corners, [], faces)
+    cube = bpy.data.objects.new("Cube", mesh)
+    bpy.context.scene.collection.objects.link(cube)
+    material = bpy.data.materials.new("Chair Paint")
+    if material.node_tree is None:
+        material.use_nodes = True
+    mesh.materials.append(material)
+    if group:
+        node = material.node_tree.nodes.new("ShaderNodeGroup")
+        node.name = "user group node"
+        node.node_tree = user_group(group)
+    bpy.ops.wm.save_as_mainfile(filepath=path)
 
 
-def inspect(path):
+def inspect(path, out):
     bpy.ops.wm.open_mainfile(filepath=path)
-    print("GLOFFUSE_RESULT " + json.dumps({
-        "version": list(bpy.data.version),
-        "images": {image.name: image.filepath for image in bpy.data.images},
-        "groups": sorted(group.name for group in bpy.data.node_groups),
-        "materials": sorted(material.name for material in bpy.data.materials),
-    }))
+    groups = {
+        tree.name: {"tag": tree.get("gloffuse"), "nodes": sorted(n.name for n in tree.nodes)}
+        for tree in bpy.data.node_groups if tree.library is None
+    }
+    materials = {
+        m.name: sorted(n.node_tree.name for n in m.node_tree.nodes
+                       if n.bl_idname == "ShaderNodeGroup" and n.node_tree is not None)
+        for m in bpy.data.materials if m.node_tree is not None
+    }
+    report = {
+        "groups": groups,
+        "materials": materials,
+        "scene_tags": [scene.get("gloffuse") for scene in bpy.data.scenes],
+        "objects": len(bpy.data.objects),
+    }
+    with open(out, "w", encoding="utf-8") as f:
+        json.dump(report, f, indent=1, sort_keys=True)
 
 
 def main():
     options = args()
-    if options.action == "make":
-        make(options.path, options.compress, options.texture)
-    else:
-        inspect(options.path)
+    try:
+        if options.make:
+            make(options.make, options.group)
+        else:
+            inspect(options.inspect, options.out)
+    except Exception:
+        traceback.print_exc()
+        sys.stdout.flush()
+        sys.exit(1)
     sys.stdout.flush()
 
 

@@ -472,12 +472,45 @@ def gain_at(curve, roughness):
 # Building the groups
 # ---------------------------------------------------------------------------
 
+# The custom property that marks a node group (and a library's scene) as made
+# by gloffuse; its value is the gloffuse version. Only tagged groups are ever
+# rebuilt: a group of the same name without it is the user's own.
+GLOFFUSE_TAG = "gloffuse"
+
+
+def is_tagged(id_block):
+    return GLOFFUSE_TAG in id_block.keys()
+
+
+def set_aside_untagged(names):
+    """Rename every local node group called one of `names` that carries no
+    gloffuse tag (the user's own, or one made before tagging) to a free name,
+    "NAME (yours)" (Blender adds .001 etc. if that is taken). Renaming keeps
+    the datablock, so every material using it still does. Returns
+    [[old name, new name], ...]."""
+    renamed = []
+    for tree in list(bpy.data.node_groups):
+        if tree.library is not None or tree.name not in names or is_tagged(tree):
+            continue
+        old = tree.name
+        tree.name = old + " (yours)"
+        if tree.name in names or tree.name == old:
+            raise ValueError("could not rename your node group %r out of the way; rename "
+                             "it and run again" % old)
+        renamed.append([old, tree.name])
+    return renamed
+
+
 def reuse_or_create_group(name):
     """The local ShaderNodeTree called `name`, emptied of nodes, or a new one.
     Reusing the datablock keeps every material that uses it working (no
-    ".001" copy, same pointer)."""
+    ".001" copy, same pointer). Untagged groups must have been set aside
+    first (set_aside_untagged): one left here is refused, never emptied."""
     for tree in bpy.data.node_groups:
         if tree.name == name and tree.library is None:
+            if not is_tagged(tree):
+                raise ValueError("the node group %r was not made by gloffuse and was not "
+                                 "set aside" % name)
             if tree.bl_idname != "ShaderNodeTree":
                 raise ValueError("a node group called %r already exists but is a %s, "
                                  "not a shader node group; rename it and run again"
@@ -487,6 +520,8 @@ def reuse_or_create_group(name):
     tree = bpy.data.node_groups.new(name, "ShaderNodeTree")
     if tree.name != name:
         raise ValueError("Blender renamed the new node group %r to %r" % (name, tree.name))
+    # Tagged at once (build_all writes the version), so a rebuild in this run reuses it.
+    tree[GLOFFUSE_TAG] = ""
     return tree
 
 
@@ -1820,9 +1855,27 @@ def build_layered_group(spec, params):
 #
 # A module of the gloffuse_blender package. Functions only.
 #
+#   group_names(params) -> every group name build_all builds
 #   build_all(params) -> [(spec, [trees...]), ...]   (params resolved by
 #                                                     params.py's resolve_params)
+#   mark_library(params), library_contents() -> the marker of a gloffuse library
 # ---------------------------------------------------------------------------
+
+
+
+def group_names(params):
+    """Every node group name build_all(params) builds, in the order it builds them."""
+    names = []
+    for spec in params["groups"]:
+        view = spec.get("view") or {}
+        layered = spec.get("layered") or {}
+        for name in (spec.get("normal_group") if view or layered else None,
+                     spec["correction_group"], spec["shader_group"],
+                     view.get("correction_group"), view.get("shader_group"),
+                     view.get("multiscatter_group"), layered.get("shader_group")):
+            if name is not None and name not in names:
+                names.append(name)
+    return names
 
 
 def build_all(params):
@@ -1854,7 +1907,33 @@ def build_all(params):
         if spec.get("layered"):
             trees.append(build_layered_group(spec, params))
         built.append((spec, trees))
+    names = group_names(params)
+    for _spec, trees in built:
+        for tree in trees:
+            if tree.name not in names:
+                raise ValueError("group_names misses the group %r it must set aside" % tree.name)
+            tree[GLOFFUSE_TAG] = params.get("gloffuse_version", "")
     return built
+
+
+def mark_library(params):
+    """Mark the open file as a gloffuse library: its scenes carry the tag (the
+    version). generate --blend replaces only a file that has it."""
+    for scene in bpy.data.scenes:
+        scene[GLOFFUSE_TAG] = params.get("gloffuse_version", "")
+
+
+def library_contents():
+    """None if the open file is a gloffuse library (a scene carries the tag),
+    else what it holds instead, in words."""
+    if any(is_tagged(scene) for scene in bpy.data.scenes):
+        return None
+    counts = [(len(bpy.data.objects), "object"), (len(bpy.data.materials), "material"),
+              (len(bpy.data.meshes), "mesh"), (len(bpy.data.node_groups), "node group"),
+              (len(bpy.data.images), "image")]
+    held = ["%d %s%s" % (n, what, "" if n == 1 else "es" if what == "mesh" else "s")
+            for n, what in counts if n]
+    return "no gloffuse library marker; it holds %s" % (", ".join(held) or "nothing")
 
 # ======== gloffuse part: meshes.py ========
 # ---------------------------------------------------------------------------
@@ -2183,7 +2262,9 @@ def render_previews(built, directory):
 #   blender -b --factory-startup -noaudio --python-exit-code 1 --python THIS.py -- [--open IN.blend] [--save OUT.blend]
 #   python3 THIS.py [--open IN.blend] [--save OUT.blend]      (with the bpy module)
 #
-# Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...], "saved": ...}
+# Prints one line on stdout: GLOFFUSE_RESULT {"blender_version": ..., "groups": [...],
+# "renamed": [[yours, now], ...], "saved": ...}, or {"refused": why, ...} when
+# --replace-library names a file that is not a gloffuse library (nothing saved).
 # The job module of the generate script: the gloffuse binary bundles it with
 # the modules it imports, after the header that defines GLOFFUSE_PARAMS (the
 # parameter document as a JSON string), and ends the script with
@@ -2204,19 +2285,34 @@ def parse_generate_args(argv=None):
                         help="save the result as this .blend file (default: do not save)")
     parser.add_argument("--compress", action="store_true",
                         help="save compressed (as the file opened was)")
+    parser.add_argument("--replace-library", metavar="OLD.blend",
+                        help="the library the new one replaces: refuse (save nothing) unless "
+                             "it carries the gloffuse library marker")
     return parse_script_args(parser, argv)
 
 
 def generate_main(document_text):
     options = parse_generate_args()
     params = load_params(document_text)
+    if options.replace_library:
+        open_blend(options.replace_library)
+        refused = library_contents()
+        if refused is not None:
+            print(result_line({"blender_version": blender_version_string(),
+                               "refused": refused, "saved": None}))
+            sys.stdout.flush()
+            return
+    new_library = not options.open and options.save and bpy.app.background
     if options.open:
         open_blend(options.open)
-    elif options.save and bpy.app.background:
+    elif new_library:
         # A new library file holds the groups and nothing else: not the startup
         # file's cube, camera and light.
         bpy.ops.wm.read_factory_settings(use_empty=True)
+    renamed = set_aside_untagged(group_names(params))
     built = build_all(params)
+    if new_library:
+        mark_library(params)
     if params.get("previews") and bpy.app.background:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
             render_previews(built, directory)
@@ -2227,6 +2323,7 @@ def generate_main(document_text):
     print(result_line({
         "blender_version": blender_version_string(),
         "groups": names,
+        "renamed": renamed,
         "saved": saved,
     }))
     sys.stdout.flush()

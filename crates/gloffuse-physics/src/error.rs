@@ -124,6 +124,8 @@ pub enum Field {
     BlenderVersion,
     /// The .blend library to write.
     Blend,
+    /// The asset catalog definition file beside a library (`blender_assets.cats.txt`).
+    Catalogs,
     Coefficients,
     Color,
     /// The geometry of a contact sheet of renders.
@@ -134,6 +136,9 @@ pub enum Field {
     Engine,
     /// The Blender extension (.zip) to write.
     Extension,
+    /// Replace an existing file that is not what a command would replace unasked (a
+    /// library .blend that is not a gloffuse library).
+    Force,
     /// A table's file format.
     Format,
     /// The masking function of a split-sum table.
@@ -188,6 +193,7 @@ impl Field {
             Field::Blender => "blender",
             Field::BlenderVersion => "Blender version",
             Field::Blend => "library .blend",
+            Field::Catalogs => "asset catalog file",
             Field::Coefficients => "coefficients",
             Field::Color => "colour",
             Field::ContactSheet => "contact sheet",
@@ -195,6 +201,7 @@ impl Field {
             Field::Distribution => "distribution",
             Field::Engine => "engine",
             Field::Extension => "extension",
+            Field::Force => "force",
             Field::Format => "format",
             Field::GModel => "masking model",
             Field::Into => "file to update",

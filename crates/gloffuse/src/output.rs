@@ -144,6 +144,16 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), Error> {
 /// Writes `bytes` to the regular file `path` atomically (temporary file + rename in the
 /// same directory), keeping the permissions of a file it replaces.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let tmp = staged(path, bytes)?;
+    tmp.persist(path)
+        .map_err(|e| fail(path, e.error.to_string()))?;
+    Ok(())
+}
+
+/// `bytes` written and synced to a temporary file beside the regular file `path`, with the
+/// permissions of the file it will replace: renaming it over `path` is the atomic write.
+/// Dropped unrenamed, it is removed.
+pub fn staged(path: &Path, bytes: &[u8]) -> Result<tempfile::TempPath, Error> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -173,8 +183,7 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
             .map_err(err)?;
     }
     tmp.as_file().sync_all().map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error))?;
-    Ok(())
+    Ok(tmp.into_temp_path())
 }
 
 /// Makes the report folder `dir` if it does not exist (its parent must), and checks that

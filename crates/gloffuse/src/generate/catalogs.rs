@@ -6,10 +6,20 @@
 //! `blender_assets.cats.txt` (Blender's catalog definition file: a `VERSION 1` line, then
 //! `UUID:path:simple name` lines) is merged, never clobbered: the user's lines stay as
 //! they are, a catalog the user already has for one of our paths is used as it is, and only
-//! the missing ones are added.
+//! the missing ones are added. A file Blender would ignore (no `VERSION 1` line) or misread
+//! (a line whose id is not a UUID) is refused, never appended to. The file is read once
+//! before the Blender run (bad input fails fast, and the groups get the user's ids), and
+//! again under a lock just before it is replaced, so catalogs added meanwhile are kept.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use uuid::Uuid;
+
+use crate::error::{Error, Field, Hint};
+use crate::output::staged;
 
 /// The name of Blender's catalog definition file, beside the .blend (the library root).
 pub const FILE_NAME: &str = "blender_assets.cats.txt";
@@ -57,14 +67,77 @@ impl Default for Catalogs {
     }
 }
 
-/// A catalog line of a definition file: `(uuid, path)`.
-fn parse_line(line: &str) -> Option<(&str, &str)> {
-    let line = line.trim();
-    if line.is_empty() || line.starts_with('#') || line.starts_with("VERSION") {
-        return None;
+/// What Blender expects of a definition file, said once for every refusal.
+const EXPECTED: &str = "Blender's asset catalog definition file: a `VERSION 1` line first \
+    (after comments), then lines `UUID:catalog/path:simple name` with UUIDs like \
+    9df742e7-f3ca-55de-8a87-d10e33fe9382 (fix or move the file, then run again)";
+
+/// The catalog lines of a definition file, `(uuid, path)`, checked as Blender reads it: the
+/// first line that is not blank or a comment is `VERSION 1`, and every line after it has a
+/// UUID. `Err` is (1-based line number, or 0 for the file, and what is wrong).
+fn parse(text: &str) -> Result<Vec<(&str, &str)>, (usize, String)> {
+    let mut version = false;
+    let mut lines = Vec::new();
+    for (index, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        if !version {
+            if line != "VERSION 1" {
+                return Err((
+                    index + 1,
+                    format!("its first line is `{line}`, not `VERSION 1`"),
+                ));
+            }
+            version = true;
+            continue;
+        }
+        let mut parts = line.splitn(3, ':');
+        let uuid = parts.next().unwrap_or_default();
+        let path = parts.next();
+        // Blender reads the hyphenated form only.
+        let valid = uuid.len() == 36 && Uuid::try_parse(uuid).is_ok();
+        match path {
+            Some(path) if valid => lines.push((uuid, path)),
+            _ => return Err((index + 1, format!("`{uuid}` is not a UUID"))),
+        }
     }
-    let mut parts = line.splitn(3, ':');
-    Some((parts.next()?, parts.next()?))
+    if !version {
+        return Err((0, "it has no `VERSION 1` line".to_string()));
+    }
+    Ok(lines)
+}
+
+/// The definition file at `file`, checked (`None`: there is none, or it is empty).
+pub fn read(file: &Path) -> Result<Option<String>, Error> {
+    let text = match std::fs::read_to_string(file) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => {
+            return Err(Error::Read {
+                path: file.to_path_buf(),
+                source,
+            });
+        }
+    };
+    if text.trim().is_empty() {
+        return Ok(None);
+    }
+    match parse(&text) {
+        Ok(_) => Ok(Some(text)),
+        Err((line, why)) => {
+            let at = match line {
+                0 => file.display().to_string(),
+                n => format!("{}, line {n}", file.display()),
+            };
+            Err(Error::input(
+                Field::Catalogs,
+                at,
+                Hint::text(format!("{EXPECTED}; {why}")),
+            ))
+        }
+    }
 }
 
 impl Catalogs {
@@ -72,8 +145,9 @@ impl Catalogs {
     /// the catalogs to assign (the user's own id where they already have one of our paths)
     /// and the file's new text.
     pub fn merge(&self, existing: Option<&str>) -> (Catalogs, String) {
+        // The caller checked the file (`read`); unreadable lines would only be kept as text.
         let lines: Vec<(&str, &str)> = existing
-            .map(|text| text.lines().filter_map(parse_line).collect())
+            .and_then(|text| parse(text).ok())
             .unwrap_or_default();
         let mut text = match existing {
             Some(t) if !t.trim().is_empty() => {
@@ -91,10 +165,7 @@ impl Catalogs {
                 ..ours.clone()
             },
             None => {
-                text.push_str(&format!(
-                    "{}:{}:{}\n",
-                    ours.uuid, ours.path, ours.simple_name
-                ));
+                text.push_str(&ours.line());
                 ours.clone()
             }
         };
@@ -110,6 +181,103 @@ impl Catalogs {
             text.push_str(&c.line());
         }
         text
+    }
+}
+
+/// The merged definition file, written beside `file` under a temporary name while the lock
+/// is held: [`Staged::commit`] renames it into place; dropped, it leaves the folder as it
+/// was.
+pub struct Staged {
+    file: PathBuf,
+    tmp: tempfile::TempPath,
+    _lock: Lock,
+}
+
+/// Re-reads the definition file `file` under its lock, merges the catalogs `ours` (already
+/// resolved against the file as it was before the run) into it, and stages the result.
+pub fn stage(file: &Path, ours: &Catalogs) -> Result<Staged, Error> {
+    let lock = Lock::take(file)?;
+    let existing = read(file)?;
+    let (_, text) = ours.merge(existing.as_deref());
+    let tmp = staged(file, text.as_bytes())?;
+    Ok(Staged {
+        file: file.to_path_buf(),
+        tmp,
+        _lock: lock,
+    })
+}
+
+impl Staged {
+    /// Renames the staged file into place, then releases the lock.
+    pub fn commit(self) -> Result<PathBuf, Error> {
+        let Staged { file, tmp, _lock } = self;
+        tmp.persist(&file).map_err(|e| Error::Write {
+            path: file.clone(),
+            message: e.error.to_string(),
+        })?;
+        Ok(file)
+    }
+}
+
+/// An advisory lock (`flock`) on a hidden file beside the definition file, held while it is
+/// re-read, merged and replaced, so two gloffuse runs never lose each other's catalogs.
+/// The lock file is removed while still locked; a waiter that then wins a removed file
+/// sees that it no longer has the path and locks again.
+struct Lock {
+    path: PathBuf,
+    _file: File,
+}
+
+/// How long to wait for another run's lock (it holds it for a merge and a rename).
+const LOCK_WAIT: Duration = Duration::from_secs(30);
+
+impl Lock {
+    fn take(file: &Path) -> Result<Lock, Error> {
+        use std::os::unix::fs::MetadataExt;
+        let name = format!(".{FILE_NAME}.gloffuse-lock");
+        let path = file.parent().unwrap_or(Path::new(".")).join(name);
+        let fail = |message: String| Error::Write {
+            path: path.clone(),
+            message,
+        };
+        let start = Instant::now();
+        loop {
+            let handle = std::fs::OpenOptions::new()
+                .create(true)
+                .truncate(false)
+                .write(true)
+                .open(&path)
+                .map_err(|e| fail(e.to_string()))?;
+            match handle.try_lock() {
+                Ok(()) => {
+                    let held = handle.metadata().map_err(|e| fail(e.to_string()))?;
+                    let current = std::fs::metadata(&path);
+                    if current.is_ok_and(|m| m.ino() == held.ino() && m.dev() == held.dev()) {
+                        return Ok(Lock {
+                            path,
+                            _file: handle,
+                        });
+                    }
+                }
+                Err(std::fs::TryLockError::WouldBlock) => {}
+                Err(std::fs::TryLockError::Error(e)) => return Err(fail(e.to_string())),
+            }
+            if start.elapsed() > LOCK_WAIT {
+                return Err(fail(format!(
+                    "another process has held this lock for over {} s; if none is running, \
+                     remove the file",
+                    LOCK_WAIT.as_secs()
+                )));
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        // Removed before the handle (and so the lock) is released: see `Lock`.
+        let _ = std::fs::remove_file(&self.path);
     }
 }
 
@@ -155,5 +323,104 @@ mod tests {
             "{}:Shader/Gloffuse Helpers:Shader-Gloffuse Helpers\n",
             ours.helper.uuid
         )));
+    }
+
+    #[test]
+    fn files_blender_would_ignore_or_misread_are_refused() {
+        let ok = "# mine\n\nVERSION 1\n\n0e5a7f27-7e0e-4a11-9a35-1f4b2a7c9d01:A/B:A-B\n";
+        assert_eq!(
+            parse(ok),
+            Ok(vec![("0e5a7f27-7e0e-4a11-9a35-1f4b2a7c9d01", "A/B")])
+        );
+        let refused = |text: &str| parse(text).unwrap_err();
+        assert_eq!(refused("# only comments\n").0, 0);
+        assert_eq!(refused("VERSION 2\n").0, 1);
+        assert_eq!(
+            refused("0e5a7f27-7e0e-4a11-9a35-1f4b2a7c9d01:A:A\nVERSION 1\n").0,
+            1
+        );
+        // Ids Blender does not read: not hex, a UUID's other spellings, no path.
+        for bad in [
+            "zzzzzzzz-7e0e-4a11-9a35-1f4b2a7c9d01:A:A",
+            "0e5a7f277e0e4a119a351f4b2a7c9d01:A:A",
+            "{0e5a7f27-7e0e-4a11-9a35-1f4b2a7c9d01}:A:A",
+            "0e5a7f27-7e0e-4a11-9a35-1f4b2a7c9d01",
+            "Shader",
+        ] {
+            let (line, why) = refused(&format!("VERSION 1\n\n{bad}\n"));
+            assert_eq!(line, 3, "{bad}");
+            assert!(why.contains("is not a UUID"), "{why}");
+        }
+    }
+
+    #[test]
+    fn read_names_the_file_and_the_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join(FILE_NAME);
+        assert_eq!(read(&file).unwrap(), None, "no file");
+        std::fs::write(&file, "  \n").unwrap();
+        assert_eq!(read(&file).unwrap(), None, "an empty file is a new one");
+        std::fs::write(&file, "VERSION 1\nnot-a-uuid:A:A\n").unwrap();
+        let message = read(&file).unwrap_err().to_string();
+        let at = format!("{}, line 2", file.display());
+        assert!(message.contains(&at), "{message}");
+        assert!(message.contains("`not-a-uuid` is not a UUID"), "{message}");
+        std::fs::write(&file, "# mine\n").unwrap();
+        let message = read(&file).unwrap_err().to_string();
+        assert!(message.contains("has no `VERSION 1` line"), "{message}");
+        std::fs::remove_file(&file).unwrap();
+        std::fs::create_dir(&file).unwrap();
+        assert!(matches!(read(&file), Err(Error::Read { .. })), "a folder");
+    }
+
+    #[test]
+    fn staging_merges_the_file_as_it_is_then_and_leaves_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join(FILE_NAME);
+        let ours = Catalogs::default();
+        // Read before the run: none. Meanwhile the user writes one with a catalog.
+        let user = "VERSION 1\n1b2c3d4e-0000-4000-8000-000000000001:Props:Props\n";
+        std::fs::write(&file, user).unwrap();
+        let staged = stage(&file, &ours).unwrap();
+        let lock = dir.path().join(format!(".{FILE_NAME}.gloffuse-lock"));
+        assert!(lock.exists(), "held while staged");
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), user, "not yet");
+        assert_eq!(staged.commit().unwrap(), file);
+        let text = std::fs::read_to_string(&file).unwrap();
+        assert!(text.starts_with(user), "{text}");
+        assert!(text.ends_with(&ours.helper.line()), "{text}");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 1, "no lock or temporary file left");
+        // Dropped unrenamed: the folder as it was.
+        std::fs::write(&file, user).unwrap();
+        drop(stage(&file, &ours).unwrap());
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), user);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        // A bad file is refused under the lock too, and the lock released.
+        std::fs::write(&file, "VERSION 2\n").unwrap();
+        assert!(stage(&file, &ours).is_err());
+        assert!(!lock.exists());
+    }
+
+    #[test]
+    fn a_second_stager_waits_for_the_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join(FILE_NAME);
+        let ours = Catalogs::default();
+        let first = stage(&file, &ours).unwrap();
+        let (file2, ours2) = (file.clone(), ours.clone());
+        let waiter = std::thread::spawn(move || {
+            let started = Instant::now();
+            let second = stage(&file2, &ours2).unwrap();
+            (started.elapsed(), second.commit().unwrap())
+        });
+        std::thread::sleep(Duration::from_millis(300));
+        first.commit().unwrap();
+        let (waited, _) = waiter.join().unwrap();
+        assert!(waited >= Duration::from_millis(250), "{waited:?}");
+        // The second saw the first's file: nothing added twice.
+        let text = std::fs::read_to_string(&file).unwrap();
+        assert_eq!(text, ours.definition_file());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }

@@ -42,6 +42,8 @@ pub struct GenerateOptions {
     /// Let `into` be a file saved by a newer Blender than the one that runs (its newer
     /// data is lost).
     pub allow_downgrade: bool,
+    /// Let `blend` replace an existing file that is not a gloffuse library.
+    pub force: bool,
     /// Write a Blender extension (.zip) that installs the library as an asset library.
     pub extension: Option<PathBuf>,
     /// Which groups to build besides the roughness-only pair.
@@ -60,6 +62,7 @@ impl Default for GenerateOptions {
             blend: None,
             into: None,
             allow_downgrade: false,
+            force: false,
             extension: None,
             modes: vec![Mode::Roughness],
             engines: Vec::new(),
@@ -81,7 +84,17 @@ pub struct Generated {
     pub catalogs: Option<PathBuf>,
     pub extension: Option<PathBuf>,
     pub groups: Vec<String>,
+    /// The user's own groups (no gloffuse tag) that had a name gloffuse builds: renamed out
+    /// of the way, every material using them still does.
+    pub renamed: Vec<RenamedGroup>,
     pub log: Option<PathBuf>,
+}
+
+/// A node group of the user's that was in the way, and its new name.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct RenamedGroup {
+    pub group: String,
+    pub renamed_to: String,
 }
 
 /// Refuses what cannot work before anything is looked for or written.
@@ -192,6 +205,7 @@ fn engines_of(
 pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
     // Inputs and coefficients are checked before Blender is looked for: bad input fails fast.
     check_inputs(g)?;
+    check_library(g)?;
     let pinned = pinned_coefficients(g)?;
     let engines = engines_of(g, pinned.as_ref().map(|(c, name)| (c, *name)))?;
     let blender = blender_for(g, progress)?;
@@ -207,6 +221,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         catalogs: None,
         extension: None,
         groups: params.group_names(),
+        renamed: Vec::new(),
         log: None,
     };
     let Some(blender) = blender else {
@@ -221,15 +236,22 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         .transpose()?;
     let built = run_blender(g, &blender, &script, user_blend.as_ref())?;
     out.log = Some(built.log.clone());
-    // Everything is made before anything is written: a failed run leaves no output at all.
+    out.renamed = built.renamed.clone();
+    // Everything is made before anything is written: a failed run leaves no output at all,
+    // and the catalog file is staged (under its lock) before the library is replaced.
     let package = package_extension(g, &built, &params, &blender)?;
+    let catalogs = catalogs
+        .map(|file| catalogs::stage(&file, &params.catalogs))
+        .transpose()?;
     write_script(g, &script, &mut out)?;
     if let (Some(zip), Some(bytes)) = (&g.extension, &package) {
         write_output(zip, bytes)?;
         out.extension = Some(zip.clone());
     }
     install_blend(built, user_blend.as_ref(), &mut out)?;
-    write_catalogs(catalogs, &mut out)?;
+    if let Some(staged) = catalogs {
+        out.catalogs = Some(staged.commit()?);
+    }
     Ok(out)
 }
 
@@ -274,27 +296,56 @@ fn script_params(
 }
 
 /// A new .blend gets the catalogs of the definition file beside it (the user's own catalog
-/// for one of our paths wins): merges them into `params` and returns the file and its
-/// merged text, to write once the .blend is in place. `--into` keeps the user's file as it
-/// is apart from the groups, and a script leaves both to the Blender it runs in.
+/// for one of our paths wins): checks the file and its destination, merges its catalogs
+/// into `params` and returns the file, to re-read, merge and write once the .blend is made
+/// ([`catalogs::stage`]). `--into` keeps the user's file as it is apart from the groups, and
+/// a script leaves both to the Blender it runs in.
 fn merge_catalogs(
     g: &GenerateOptions,
     params: &mut GenerateParams,
-) -> Result<Option<(PathBuf, String)>, Error> {
+) -> Result<Option<PathBuf>, Error> {
     let Some(file) = (match &g.blend {
         Some(blend) => catalogs_beside(blend)?,
         None => None,
     }) else {
         return Ok(None);
     };
-    let existing = match std::fs::read_to_string(&file) {
-        Ok(text) => Some(text),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-        Err(source) => return Err(Error::Read { path: file, source }),
+    if let Destination::Stream(_) | Destination::Stdout = check_destination(&file)? {
+        return Err(Error::Write {
+            path: file,
+            message: "the asset catalog definition file must be a regular file".to_string(),
+        });
+    }
+    let existing = catalogs::read(&file)?;
+    params.catalogs = params.catalogs.merge(existing.as_deref()).0;
+    Ok(Some(file))
+}
+
+/// Refuses, before Blender runs, a `blend` destination that exists but is no .blend at all
+/// (unless `force`); whether a .blend is a gloffuse library is checked in the Blender run.
+fn check_library(g: &GenerateOptions) -> Result<(), Error> {
+    let Some(blend) = &g.blend else {
+        return Ok(());
     };
-    let (merged, text) = params.catalogs.merge(existing.as_deref());
-    params.catalogs = merged;
-    Ok(Some((file, text)))
+    if g.force || !blend.is_file() || read_header(blend).is_ok() {
+        return Ok(());
+    }
+    Err(not_a_library(blend, "it is not a .blend file"))
+}
+
+/// The refusal of a `blend` destination that is not a gloffuse library.
+fn not_a_library(blend: &std::path::Path, why: &str) -> Error {
+    Error::input(
+        Field::Blend,
+        blend.display(),
+        Hint::new(
+            format!(
+                "a new file or a gloffuse library to replace ({why}); to replace it anyway, \
+                 add {{}}"
+            ),
+            [Field::Force],
+        ),
+    )
 }
 
 /// The coefficients the groups use, as [`Generated`] names them: the pinned ones, else
@@ -339,6 +390,7 @@ struct Built {
     dest: Option<PathBuf>,
     target: Destination,
     log: PathBuf,
+    renamed: Vec<RenamedGroup>,
 }
 
 /// Runs the script in `blender`, saving the .blend under a temporary name, and checks that
@@ -377,6 +429,7 @@ fn run_blender(
             args.push(OsString::from("--compress"));
         }
     }
+    args.extend(library_args(g, &target));
     args.extend([OsString::from("--save"), tmp.to_path_buf().into_os_string()]);
     let log = run_dir.join("blender.log");
     let run = Run {
@@ -388,7 +441,8 @@ fn run_blender(
         log: log.clone(),
     };
     // A run stopped while Blender saved leaves its partial `NAME@` beside the temp name.
-    run_script(&run).inspect_err(|_| remove_partial_save(&tmp))?;
+    let output = run_script(&run).inspect_err(|_| remove_partial_save(&tmp))?;
+    let renamed = job_report(g, &output.result)?;
     if let Some(why) = incomplete_blend(&tmp) {
         return Err(Error::Blender {
             message: format!("Blender reported success but {why}").into(),
@@ -401,6 +455,7 @@ fn run_blender(
         dest,
         target,
         log,
+        renamed,
     })
 }
 
@@ -409,6 +464,37 @@ fn remove_partial_save(saved: &Path) {
     let mut partial = saved.as_os_str().to_owned();
     partial.push("@");
     let _ = std::fs::remove_file(partial);
+}
+
+/// The job's check of the library a `blend` replaces: the existing file, unless `force`.
+fn library_args(g: &GenerateOptions, target: &Destination) -> Vec<OsString> {
+    match (&g.blend, target) {
+        (Some(_), Destination::File(real)) if real.is_file() && !g.force => {
+            vec![OsString::from("--replace-library"), real.clone().into()]
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// What the job's result says beyond success: a refused library (an input error), and the
+/// user's groups it renamed.
+fn job_report(g: &GenerateOptions, result: &serde_json::Value) -> Result<Vec<RenamedGroup>, Error> {
+    if let (Some(why), Some(blend)) = (result["refused"].as_str(), &g.blend) {
+        return Err(not_a_library(blend, why));
+    }
+    let renamed = result["renamed"]
+        .as_array()
+        .map(Vec::as_slice)
+        .unwrap_or(&[]);
+    Ok(renamed
+        .iter()
+        .filter_map(|pair| {
+            Some(RenamedGroup {
+                group: pair[0].as_str()?.to_string(),
+                renamed_to: pair[1].as_str()?.to_string(),
+            })
+        })
+        .collect())
 }
 
 /// The extension's .zip in memory, if one is asked for: the saved .blend and its catalogs.
@@ -466,15 +552,6 @@ fn install_blend(
         }
     }
     out.blend = Some(dest);
-    Ok(())
-}
-
-/// Writes the merged catalog definition file beside the new .blend, if there is one.
-fn write_catalogs(catalogs: Option<(PathBuf, String)>, out: &mut Generated) -> Result<(), Error> {
-    if let Some((file, text)) = catalogs {
-        write_output(&file, text.as_bytes())?;
-        out.catalogs = Some(file);
-    }
     Ok(())
 }
 
