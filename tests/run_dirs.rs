@@ -83,7 +83,16 @@ fn a_live_run_of_another_process_survives_25_newer_runs() {
     fs::create_dir_all(&root).unwrap();
     let dead = dead_runs(&root);
     let mut verify = std::process::Command::new(env!("CARGO_BIN_EXE_gloffuse"))
-        .args(["verify", "--no-provision", "-d", "ggx", "-r", "0.5", "--spp", "256"])
+        .args([
+            "verify",
+            "--no-provision",
+            "-d",
+            "ggx",
+            "-r",
+            "0.5",
+            "--spp",
+            "256",
+        ])
         .arg("--blender")
         .arg(&blender)
         .env("XDG_CACHE_HOME", cache.path())

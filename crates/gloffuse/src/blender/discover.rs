@@ -336,7 +336,12 @@ fn removal_advice(venv: &std::path::Path) -> Hint {
 /// A cached venv at `python`'s venv failed (its probe, or its repair): the error, and how
 /// to remove the venv.
 fn with_removal_advice(e: Error, python: &std::path::Path) -> Error {
-    let Some(venv) = python.parent().and_then(|bin| bin.parent()) else {
+    // A repair that failed after removing the venv needs no advice: the next run installs.
+    let Some(venv) = python
+        .parent()
+        .and_then(|bin| bin.parent())
+        .filter(|v| v.symlink_metadata().is_ok())
+    else {
         return e;
     };
     match e {
