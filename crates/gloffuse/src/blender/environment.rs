@@ -65,3 +65,39 @@ pub fn which(name: &str, path: Option<&std::ffi::OsStr>) -> Option<PathBuf> {
             std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
         })
 }
+
+/// Why the venv at `venv` can no longer run, if it cannot: its Python was moved or removed
+/// (as after a CI image update) — `bin/python` missing or a dangling link, or the base
+/// interpreter `pyvenv.cfg` names (`executable`, else `home`) gone. A working venv, or one
+/// that cannot be judged without running it, gives `None`.
+pub fn broken_venv(venv: &Path) -> Option<String> {
+    let python = venv_python(venv);
+    if std::fs::symlink_metadata(&python).is_err() {
+        return Some(format!("{} is missing", python.display()));
+    }
+    if std::fs::metadata(&python).is_err() {
+        let target = std::fs::read_link(&python).unwrap_or_default();
+        return Some(format!(
+            "{} is a dangling link (to {})",
+            python.display(),
+            target.display()
+        ));
+    }
+    let cfg = std::fs::read_to_string(venv.join("pyvenv.cfg")).ok()?;
+    let value = |key: &str| {
+        cfg.lines().find_map(|l| {
+            let (k, v) = l.split_once('=')?;
+            (k.trim() == key).then(|| v.trim().to_string())
+        })
+    };
+    let (key, base) = match value("executable") {
+        Some(e) => ("executable", e),
+        None => ("home", value("home")?),
+    };
+    (!Path::new(&base).exists()).then(|| {
+        format!(
+            "its pyvenv.cfg names {key} = {base}, which no longer exists (the Python it was \
+             made with has moved)"
+        )
+    })
+}

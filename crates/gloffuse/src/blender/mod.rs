@@ -12,7 +12,7 @@ pub mod provision;
 pub mod run;
 pub mod runs;
 
-pub use discover::{FindOptions, find_blender};
+pub use discover::{FindOptions, Need, find_blender};
 pub use probe::{Blender, BlenderKind, probe};
 pub use process::Cancel;
 pub use provision::InstallerOutput;
@@ -56,6 +56,13 @@ impl Default for BlenderOptions {
 impl BlenderOptions {
     /// Finds Blender as the options say and announces which one is used.
     pub fn find(&self, progress: &dyn Progress) -> Result<Blender, Error> {
+        self.find_for(None, progress)
+    }
+
+    /// [`find`](Self::find) for a job that needs a Blender at least as new as `need` says:
+    /// an older one the user did not name is passed over (with a notice) for the bpy cache,
+    /// or bpy is installed if allowed; one the user named is refused.
+    pub fn find_for(&self, need: Option<Need>, progress: &dyn Progress) -> Result<Blender, Error> {
         let blender = find_blender(
             &FindOptions {
                 explicit: self.program.clone(),
@@ -63,6 +70,7 @@ impl BlenderOptions {
                 installer_output: self.installer_output,
                 timeout: self.timeout,
                 cancel: self.cancel.clone(),
+                need,
             },
             progress,
         )?;

@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use super::environment::{BPY_REQUIREMENT, BPY_SERIES, ENV_VAR, Environment, venv_python, which};
+use super::environment::{
+    BPY_REQUIREMENT, BPY_SERIES, ENV_VAR, Environment, broken_venv, venv_python, which,
+};
 use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, last_lines, probe_as};
 use super::process::{Cancel, Exit, run_captured, shell_join};
 use crate::error::{Error, Field, Hint};
@@ -30,12 +32,14 @@ pub enum InstallerOutput {
 /// a probe, and only then a rename into place — an interrupted install leaves only a
 /// `.bpy-4.5.partial-*` directory, never a `bpy-4.5` that looks valid. `skipped` names
 /// the Blenders that were found but could not be used; they are announced through
-/// `progress` with the install.
+/// `progress` with the install. `broken` says why the venv already there cannot run: it is
+/// moved aside and removed (under the install lock), and the install announced as a repair.
 pub(super) fn provision(
     venv: &Path,
     env: &Environment,
     output: InstallerOutput,
     skipped: &[Hint],
+    broken: Option<&str>,
     progress: &dyn Progress,
     cancel: &Cancel,
 ) -> Result<Blender, Error> {
@@ -46,10 +50,19 @@ pub(super) fn provision(
     // One install at a time: a second gloffuse (a parallel CI job sharing the cache)
     // waits for the first, then uses what it installed.
     let _lock = InstallLock::take(&parent.join(format!(".bpy-{BPY_SERIES}.lock")), progress)?;
-    if venv_python(venv).exists() {
+    // Judged again under the lock: another gloffuse may have repaired it meanwhile.
+    let broken = broken.and_then(|_| broken_venv(venv));
+    if broken.is_none() && venv_python(venv).exists() {
         return probe_cached(&venv_python(venv), cancel);
     }
     remove_stale_partials(parent);
+    if let Some(why) = &broken {
+        progress.advise(&Hint::text(format!(
+            "the cached bpy {BPY_SERIES} at {} is broken ({why}); reinstalling it",
+            venv.display()
+        )));
+        remove_broken(venv)?;
+    }
     announce_install(venv, skipped, progress);
     let tmp = tempfile::Builder::new()
         .prefix(&format!(".bpy-{BPY_SERIES}.partial-"))
@@ -84,6 +97,24 @@ fn probe_cached(python: &Path, cancel: &Cancel) -> Result<Blender, Error> {
         Instant::now() + PROBE_TIMEOUT,
         cancel,
     )
+}
+
+/// Moves a broken venv aside (so no half-removed venv ever has the valid name) and removes
+/// it; a removal cut short leaves a `.bpy-4.5.partial-*` that the next install removes.
+fn remove_broken(venv: &Path) -> Result<(), Error> {
+    let parent = venv.parent().unwrap_or(Path::new("."));
+    let aside = parent.join(format!(
+        ".bpy-{BPY_SERIES}.partial-broken-{}",
+        std::process::id()
+    ));
+    std::fs::rename(venv, &aside).map_err(|e| write_error(venv, &e))?;
+    // A symlinked venv is only unlinked: what it points at is not gloffuse's to delete.
+    let removed = if aside.is_symlink() {
+        std::fs::remove_file(&aside)
+    } else {
+        std::fs::remove_dir_all(&aside)
+    };
+    removed.map_err(|e| write_error(&aside, &e))
 }
 
 /// Says, through `progress`, which Blenders are not used and that bpy is being installed.

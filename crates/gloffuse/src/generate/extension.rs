@@ -8,6 +8,7 @@ use std::io::{Cursor, Write};
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
 
+use crate::blender::Need;
 use crate::error::{Error, Field, Hint};
 use crate::measure::BlenderVersion;
 
@@ -49,17 +50,24 @@ copyright = ["2026 The gloffuse authors"]
     )
 }
 
-/// Refuses a Blender before 4.2: no extension system, and the library the extension packs
-/// is saved by the Blender that builds it.
+/// What building an extension needs of the Blender that builds it: no extension system
+/// before 4.2, and the library it packs is saved by that Blender.
+pub const NEED: Need = Need {
+    version: FIRST_BLENDER,
+    by: Field::Extension,
+    why: "extensions came with 4.2, and the library it packs is saved by the Blender that \
+          builds it",
+};
+
+/// Refuses a Blender before 4.2 (see [`NEED`]).
 pub fn can_build(built_with: BlenderVersion) -> Result<(), Error> {
-    if built_with < FIRST_BLENDER {
+    if built_with < NEED.version {
         return Err(Error::input(
             Field::Blender,
             format!("Blender {}.{}", built_with.major, built_with.minor),
             Hint::new(
-                "Blender 4.2 or later for {} (extensions came with 4.2, and the library it \
-                 packs is saved by the Blender that builds it)",
-                [Field::Extension],
+                format!("Blender 4.2 or later for {{}} ({})", NEED.why),
+                [NEED.by],
             ),
         ));
     }

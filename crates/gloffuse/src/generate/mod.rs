@@ -270,11 +270,9 @@ fn blender_for(g: &GenerateOptions, progress: &dyn Progress) -> Result<Option<Bl
     if !needs_blender {
         return Ok(None);
     }
-    let blender = g.blender.find(progress)?;
-    if g.extension.is_some() {
-        extension::can_build(blender.version)?;
-    }
-    Ok(Some(blender))
+    // An extension needs 4.2+: an older Blender on PATH is passed over, not refused.
+    let need = g.extension.is_some().then_some(extension::NEED);
+    Ok(Some(g.blender.find_for(need, progress)?))
 }
 
 /// The script's parameters: the pinned coefficients' curves or every engine's presets;
