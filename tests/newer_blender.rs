@@ -102,7 +102,11 @@ fn compat_answers(label: &str) -> Option<Value> {
 
 /// The answers every supported version shares.
 fn assert_common(label: &str, got: &Value) {
-    assert_eq!(got["mix_sockets"], json!(["RGBA", "RGBA", "RGBA"]), "{label}: {got}");
+    assert_eq!(
+        got["mix_sockets"],
+        json!(["RGBA", "RGBA", "RGBA"]),
+        "{label}: {got}"
+    );
     assert_eq!(got["glossy_distribution"], "GGX", "{label}: {got}");
     assert_eq!(got["glossy_roughness"], 0.5, "{label}: {got}");
     assert_eq!(got["principled_ior"], 1.5, "{label}: {got}");

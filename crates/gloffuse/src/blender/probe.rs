@@ -87,7 +87,7 @@ pub fn newer_than_known(version: BlenderVersion) -> Option<Hint> {
     };
     let message = format!(
         "Blender {version} is newer than the newest version gloffuse knows ({known}): \
-         assuming {known}'s {}; {checked} (docs/BLENDER-VERSIONS.md). For measured results \
+         assuming {known}'s rules: {}; {checked} (docs/BLENDER-VERSIONS.md). For measured results \
          give {{}} a Blender {} to {known}",
         ASSUMED.join(", "),
         BlenderVersion::OLDEST,
@@ -447,18 +447,24 @@ mod tests {
         let text = hint.render(|f| format!("--{}", f.name()));
         assert!(
             text.starts_with(
-                "Blender 5.2 is newer than the newest version gloffuse knows (5.0): assuming 5.0's "
+                "Blender 5.2 is newer than the newest version gloffuse knows (5.0): assuming 5.0's rules: "
             ),
             "{text}"
         );
         for assumption in ASSUMED {
             assert!(text.contains(assumption), "{assumption} missing: {text}");
         }
-        assert!(text.contains("Cycles 5.2's source confirms each (read, not run)"), "{text}");
+        assert!(
+            text.contains("Cycles 5.2's source confirms each (read, not run)"),
+            "{text}"
+        );
         assert!(text.contains("docs/BLENDER-VERSIONS.md"), "{text}");
         // The way out is named as an input, never as a flag.
         assert_eq!(hint.to_string(), text.replace("--blender", "blender"));
-        assert!(text.contains("give --blender a Blender 3.0 to 5.0"), "{text}");
+        assert!(
+            text.contains("give --blender a Blender 3.0 to 5.0"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -466,7 +472,9 @@ mod tests {
         for v in ["5.3", "6.0"] {
             let text = newer_than_known(version(v)).unwrap().to_string();
             assert!(
-                text.contains(&format!("nothing confirms them for {v}: Cycles' source was read up to 5.2")),
+                text.contains(&format!(
+                    "nothing confirms them for {v}: Cycles' source was read up to 5.2"
+                )),
                 "{text}"
             );
             assert!(!text.contains("confirms each"), "{text}");
