@@ -5,8 +5,10 @@ GLOFFUSE_PARAMS = "{\"gloffuse_version\":\"0.1.0\",\"height_correlated_from\":[3
 # ======== gloffuse part: compat.py ========
 # ---------------------------------------------------------------------------
 # gloffuse compat.py: the compatibility shim. Every difference between the
-# Blender versions gloffuse supports (3.4 .. 5.0; the binary, its Text Editor,
-# or the `bpy` module) lives here and nowhere else.
+# Blender versions gloffuse supports (3.4 .. 5.0 run; the binary, its Text
+# Editor, or the `bpy` module) lives here and nowhere else. A newer Blender
+# (5.1, 5.2: read in Cycles' source, not run; docs/BLENDER-VERSIONS.md) takes
+# the newest branch: every check is `>=` or a feature test, never `==`.
 #
 # A module of the gloffuse_blender package; it imports none of the others.
 # Functions and constants only. Every Blender version check of the package
@@ -193,11 +195,21 @@ def glossy_node(nodes, distribution):
     return node
 
 
-def find_socket(sockets, identifier):
+def find_socket(sockets, identifier, name=None, socket_type=None):
+    """The socket with this identifier; else (an identifier renamed in a
+    newer Blender) the one enabled socket called `name` of type `socket_type`
+    ('RGBA', 'VALUE', ...), as names and types are what the UI keeps."""
     for sock in sockets:
         if sock.identifier == identifier:
             return sock
-    raise KeyError("no socket with identifier %r" % identifier)
+    if name is not None:
+        matches = [sock for sock in sockets
+                   if sock.name == name and sock.type == socket_type
+                   and getattr(sock, "enabled", True)]
+        if len(matches) == 1:
+            return matches[0]
+    raise KeyError("Blender %s: no socket with identifier %r (nor one enabled %s socket %r)"
+                   % (blender_version_string(), identifier, socket_type, name))
 
 
 def multiply_color_node(nodes):
@@ -211,10 +223,10 @@ def multiply_color_node(nodes):
         node.blend_type = "MULTIPLY"
         node.clamp_factor = True
         node.clamp_result = False
-        fac = find_socket(node.inputs, "Factor_Float")
-        a = find_socket(node.inputs, "A_Color")
-        b = find_socket(node.inputs, "B_Color")
-        out = find_socket(node.outputs, "Result_Color")
+        fac = find_socket(node.inputs, "Factor_Float", "Factor", "VALUE")
+        a = find_socket(node.inputs, "A_Color", "A", "RGBA")
+        b = find_socket(node.inputs, "B_Color", "B", "RGBA")
+        out = find_socket(node.outputs, "Result_Color", "Result", "RGBA")
     else:
         node = nodes.new("ShaderNodeMixRGB")
         node.blend_type = "MULTIPLY"
@@ -236,7 +248,7 @@ def set_parent(node, frame):
 
 def compat_node_tree(id_block):
     """The node tree of a world or material, creating it where needed.
-    3.x/4.x: node_tree is None until use_nodes is set; 5.0: always present and
+    3.x/4.x: node_tree is None until use_nodes is set; 5.0+: always present and
     use_nodes is deprecated, so it is only touched when there is no tree."""
     if id_block.node_tree is None and hasattr(id_block, "use_nodes"):
         id_block.use_nodes = True
@@ -325,8 +337,13 @@ def compat_principled_dielectric(node, ior):
     `ior`. In 4.0+ its specular layer follows IOR (Specular IOR Level 0.5 keeps
     it as is). Before 4.0 IOR drives transmission only; the specular F0 is
     0.08 x Specular, so Specular = F0(ior) / 0.08 -- capped at 1 (F0 = 0.08,
-    IOR 1.79) by the socket."""
+    IOR 1.79) by the socket. Cycles 5.2 adds Thin Wall (off by default; on,
+    it changes transmission and subsurface only): pinned off where it exists,
+    so the reference stays the opaque dielectric gloffuse models."""
     node.inputs["IOR"].default_value = ior
+    thin_wall = node.inputs.get("Thin Wall")
+    if thin_wall is not None:
+        thin_wall.default_value = False
     if "Specular" in node.inputs:
         f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
         node.inputs["Specular"].default_value = min(f0 / 0.08, 1.0)

@@ -15,6 +15,11 @@ impl BlenderVersion {
     /// The oldest Blender whose Glossy BSDF gloffuse models (the 3.x series onwards).
     pub const OLDEST: BlenderVersion = BlenderVersion { major: 3, minor: 0 };
 
+    /// The newest Blender gloffuse has run and measured (bpy 5.0 is the newest wheel that
+    /// installs on the machines it is tested on). A newer one runs on this version's rules,
+    /// with a notice naming them (`blender::probe::newer_than_known`).
+    pub const NEWEST_KNOWN: BlenderVersion = BlenderVersion { major: 5, minor: 0 };
+
     /// The version modelled when none is named: 4.5 LTS, the series gloffuse installs.
     pub const DEFAULT: BlenderVersion = BlenderVersion { major: 4, minor: 5 };
 
@@ -31,6 +36,12 @@ impl BlenderVersion {
         } else {
             Masking::Separable
         }
+    }
+
+    /// Newer than [`Self::NEWEST_KNOWN`]: gloffuse has never run it, so what it does there
+    /// is assumed, not measured.
+    pub fn is_newer_than_known(self) -> bool {
+        self > Self::NEWEST_KNOWN
     }
 }
 
@@ -97,5 +108,19 @@ mod tests {
         assert!("four".parse::<BlenderVersion>().is_err());
         assert!("4".parse::<BlenderVersion>().is_err());
         assert!("4.5.1.2".parse::<BlenderVersion>().is_err());
+    }
+
+    #[test]
+    fn newer_than_known_is_strictly_after_5_0_and_keeps_its_masking() {
+        let v = |s: &str| s.parse::<BlenderVersion>().unwrap();
+        assert_eq!(BlenderVersion::NEWEST_KNOWN, v("5.0"));
+        assert!(!v("5.0.1").is_newer_than_known());
+        assert!(!v("3.4").is_newer_than_known());
+        assert!(v("5.1").is_newer_than_known());
+        assert!(v("5.2.0").is_newer_than_known());
+        assert!(v("6.0").is_newer_than_known());
+        // A newer Cycles is assumed to keep the height-correlated masking (it does in 5.1, 5.2).
+        assert_eq!(v("5.2").masking(), Masking::HeightCorrelated);
+        assert_eq!(v("6.0").masking(), Masking::HeightCorrelated);
     }
 }

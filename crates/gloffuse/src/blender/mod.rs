@@ -75,6 +75,9 @@ impl BlenderOptions {
             progress,
         )?;
         progress.notice(&format!("using {}", blender.describe()));
+        if let Some(assumed) = blender.newer_than_known() {
+            progress.advise(&assumed);
+        }
         Ok(blender)
     }
 }

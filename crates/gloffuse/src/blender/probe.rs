@@ -14,6 +14,21 @@ use crate::measure::BlenderVersion;
 /// a while); a shorter `--timeout` bounds it further.
 pub const PROBE_TIMEOUT: Duration = Duration::from_secs(60);
 
+/// The newest Cycles whose source was read for everything gloffuse depends on
+/// (`docs/BLENDER-VERSIONS.md`): read, not run, as its bpy wheel does not install here.
+pub const SOURCE_READ_UP_TO: BlenderVersion = BlenderVersion { major: 5, minor: 2 };
+
+/// What a Blender newer than [`BlenderVersion::NEWEST_KNOWN`] is assumed to share with it:
+/// each is something a group's correction or a verdict's prediction rests on, and each is
+/// unchanged in Cycles up to [`SOURCE_READ_UP_TO`] (`docs/BLENDER-VERSIONS.md` says where).
+pub const ASSUMED: [&str; 5] = [
+    "the height-correlated masking of GGX and Beckmann",
+    "the 3.6+ shading-normal rule (ensure_valid_specular_reflection)",
+    "the Glossy BSDF's distributions, its defaults and roughness squared",
+    "the GGX albedo tables behind Multiscatter GGX",
+    "Principled BSDF's specular set by IOR, with Thin Wall off",
+];
+
 /// Printed by the bpy probe in front of `bpy.app.version_string`.
 const BPY_MARKER: &str = "GLOFFUSE_BPY_VERSION ";
 
@@ -48,6 +63,42 @@ impl Blender {
             self.version_string,
             self.program.display()
         )
+    }
+}
+
+/// The notice for a Blender newer than gloffuse knows: which rules it assumes, whether the
+/// Cycles source read confirms them for `version`, and how to get a known version. `None`
+/// for a known version.
+pub fn newer_than_known(version: BlenderVersion) -> Option<Hint> {
+    if !version.is_newer_than_known() {
+        return None;
+    }
+    let known = BlenderVersion::NEWEST_KNOWN;
+    let checked = if version <= SOURCE_READ_UP_TO {
+        format!(
+            "Cycles {version}'s source confirms each (read, not run), and the Python side \
+             uses feature tests, not version numbers"
+        )
+    } else {
+        format!(
+            "nothing confirms them for {version}: Cycles' source was read up to \
+             {SOURCE_READ_UP_TO}"
+        )
+    };
+    let message = format!(
+        "Blender {version} is newer than the newest version gloffuse knows ({known}): \
+         assuming {known}'s rules: {}; {checked} (docs/BLENDER-VERSIONS.md). For measured results \
+         give {{}} a Blender {} to {known}",
+        ASSUMED.join(", "),
+        BlenderVersion::OLDEST,
+    );
+    Some(Hint::new(message, [Field::Blender]))
+}
+
+impl Blender {
+    /// [`newer_than_known`] for this Blender.
+    pub fn newer_than_known(&self) -> Option<Hint> {
+        newer_than_known(self.version)
     }
 }
 
@@ -371,5 +422,64 @@ mod tests {
         assert!(!is_old_version("3.4.1"));
         assert!(!is_old_version("2"));
         assert!(!is_old_version("two.79"));
+    }
+
+    fn version(s: &str) -> BlenderVersion {
+        s.parse().unwrap()
+    }
+
+    #[test]
+    fn known_versions_need_no_notice() {
+        for v in ["3.0", "3.4.1", "4.5.4", "5.0", "5.0.1"] {
+            assert!(newer_than_known(version(v)).is_none(), "{v}");
+        }
+    }
+
+    #[test]
+    fn a_probed_5_2_names_every_assumption_and_what_confirms_it() {
+        let blender = Blender {
+            kind: BlenderKind::PythonModule,
+            program: PathBuf::from("/opt/bpy52/bin/python"),
+            version: version("5.2.0"),
+            version_string: "5.2.0".into(),
+        };
+        let hint = blender.newer_than_known().expect("5.2 is newer than 5.0");
+        let text = hint.render(|f| format!("--{}", f.name()));
+        assert!(
+            text.starts_with(
+                "Blender 5.2 is newer than the newest version gloffuse knows (5.0): assuming 5.0's rules: "
+            ),
+            "{text}"
+        );
+        for assumption in ASSUMED {
+            assert!(text.contains(assumption), "{assumption} missing: {text}");
+        }
+        assert!(
+            text.contains("Cycles 5.2's source confirms each (read, not run)"),
+            "{text}"
+        );
+        assert!(text.contains("docs/BLENDER-VERSIONS.md"), "{text}");
+        // The way out is named as an input, never as a flag.
+        assert_eq!(hint.to_string(), text.replace("--blender", "blender"));
+        assert!(
+            text.contains("give --blender a Blender 3.0 to 5.0"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_version_past_the_source_read_is_not_claimed_confirmed() {
+        for v in ["5.3", "6.0"] {
+            let text = newer_than_known(version(v)).unwrap().to_string();
+            assert!(
+                text.contains(&format!(
+                    "nothing confirms them for {v}: Cycles' source was read up to 5.2"
+                )),
+                "{text}"
+            );
+            assert!(!text.contains("confirms each"), "{text}");
+        }
+        let text = newer_than_known(version("5.1")).unwrap().to_string();
+        assert!(text.contains("Cycles 5.1's source confirms each"), "{text}");
     }
 }
