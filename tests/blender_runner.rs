@@ -473,8 +473,15 @@ fn search_order_flag_then_variable_then_path_then_cache_then_provision() {
     }));
     assert_eq!(plan.last(), Some(&Step::Provision { venv: venv.clone() }));
 
-    // Once the venv exists, it is probed instead of provisioned.
+    // A venv without its Python is broken: repaired, not probed.
     fs::create_dir_all(venv.join("bin")).unwrap();
+    let plan = search_plan(&FindOptions::default(), &env);
+    assert!(
+        matches!(plan.last(), Some(Step::Repair { venv: v, .. }) if *v == venv),
+        "{plan:?}"
+    );
+    // Once the venv exists, it is probed instead of provisioned.
+    fs::write(venv.join("bin/python"), "").unwrap();
     let plan = search_plan(&FindOptions::default(), &env);
     assert!(!plan.iter().any(|s| matches!(s, Step::Provision { .. })));
     assert_eq!(
