@@ -100,10 +100,19 @@ def result_line(payload):
     return "GLOFFUSE_RESULT " + json.dumps(payload, sort_keys=True)
 
 
+def job_is_the_program():
+    """Whether this job is the program itself (python THIS.py), not code that
+    another script runs in its own process (exec), whose process is not ours
+    to end."""
+    this = globals().get("__file__")
+    return bool(this) and os.path.abspath(sys.argv[0]) == os.path.abspath(this)
+
+
 def end_process(code):
     """End a headless job with exit status `code`, its output flushed.
 
-    Under the bpy module the process ends at once (os._exit): the interpreter's
+    Under the bpy module, when the job is the program, the process ends at once
+    (os._exit): the interpreter's
     normal exit runs Blender's shutdown, which can hang for good (bpy 4.5 with
     a Python-evaluated driver in the open file), and by now the files are
     saved and the result line printed, so nothing is left to do but remove
@@ -112,7 +121,7 @@ def end_process(code):
     error there exits with `code`."""
     sys.stdout.flush()
     sys.stderr.flush()
-    if running_in_blender_binary():
+    if running_in_blender_binary() or not job_is_the_program():
         if code:
             sys.exit(code)
         return
