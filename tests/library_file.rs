@@ -13,48 +13,9 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
+use common::user_file::{inspect, listing, make};
+
 const USER_GROUP: &str = "Gloffuse (GGX)";
-
-fn user_file_script() -> &'static Path {
-    concat!(env!("CARGO_MANIFEST_DIR"), "/tests/blender/user_file.py").as_ref()
-}
-
-/// A user's scene (a cube, the material "Chair Paint", and with `group` their own local
-/// node group of that name used by the material), saved by `blender` at `path`.
-fn make_user_file(blender: &Path, path: &Path, group: Option<&str>) {
-    let mut args: Vec<&std::ffi::OsStr> = vec!["--make".as_ref(), path.as_os_str()];
-    if let Some(group) = group {
-        args.extend::<[&std::ffi::OsStr; 2]>(["--group".as_ref(), group.as_ref()]);
-    }
-    let run = common::blender::run_in_blender(blender, user_file_script(), &args);
-    assert!(
-        run.status.success() && path.is_file(),
-        "user_file.py --make failed:\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-}
-
-/// What `blender` sees in the .blend at `path` (user_file.py --inspect).
-fn inspect(blender: &Path, path: &Path) -> Value {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("inspect.json");
-    let run = common::blender::run_in_blender(
-        blender,
-        user_file_script(),
-        &[
-            "--inspect".as_ref(),
-            path.as_os_str(),
-            "--out".as_ref(),
-            out.as_os_str(),
-        ],
-    );
-    assert!(
-        run.status.success(),
-        "user_file.py --inspect failed:\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap()
-}
 
 /// `gloffuse generate --no-provision --blender BLENDER ARGS`.
 fn generate(blender: &Path, args: &[&std::ffi::OsStr]) -> assert_cmd::assert::Assert {
@@ -67,16 +28,6 @@ fn generate(blender: &Path, args: &[&std::ffi::OsStr]) -> assert_cmd::assert::As
         .assert()
 }
 
-/// The names in `dir`, sorted.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    names.sort();
-    names
-}
-
 /// Case 6: in 3.4, 4.5 and 5.0, two `--into` runs on a file whose material uses the
 /// user's own `Gloffuse (GGX)`: the first renames it (and says so, in JSON and in text),
 /// the second has nothing to rename; the user's group keeps its nodes and its material,
@@ -86,7 +37,7 @@ fn a_users_group_with_a_gloffuse_name_is_renamed_never_rebuilt() {
     for (label, blender) in common::blender::real_blenders() {
         let dir = tempfile::tempdir().unwrap();
         let blend = dir.path().join("chair.blend");
-        make_user_file(&blender, &blend, Some(USER_GROUP));
+        make(&blender, &blend, &["--group", USER_GROUP]);
         let into = ["--into".as_ref(), blend.as_os_str()];
         let first = generate(&blender, &[&into[..], &["--json".as_ref()]].concat()).success();
         let first: Value = serde_json::from_slice(&first.get_output().stdout).unwrap();
@@ -140,7 +91,7 @@ fn the_text_summary_names_a_renamed_group() {
     };
     let dir = tempfile::tempdir().unwrap();
     let blend = dir.path().join("chair.blend");
-    make_user_file(&blender, &blend, Some(USER_GROUP));
+    make(&blender, &blend, &["--group", USER_GROUP]);
     generate(&blender, &["--into".as_ref(), blend.as_os_str()])
         .success()
         .stdout(predicates::str::contains(
@@ -159,7 +110,7 @@ fn blend_replaces_only_a_gloffuse_library_unless_forced() {
     };
     let dir = tempfile::tempdir().unwrap();
     let blend = dir.path().join("scene.blend");
-    make_user_file(&blender, &blend, None);
+    make(&blender, &blend, &[]);
     let before = std::fs::read(&blend).unwrap();
     let args = ["--blend".as_ref(), blend.as_os_str()];
     let refused = generate(&blender, &args).code(2);

@@ -10,30 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-/// tests/blender/user_blend.py run in `blender` with `args`; its result line, parsed.
-fn user_file(blender: &Path, args: &[&str]) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/user_blend.py");
-    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
-    let out = common::blender::run_in_blender(blender, &script, &args);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "user_blend.py {args:?} failed\nstdout:\n{stdout}\nstderr:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("GLOFFUSE_RESULT "))
-        .map_or(Value::Null, |json| serde_json::from_str(json).unwrap())
-}
-
-/// Saves a user's scene (a cube and a material) at `path` with `blender`.
-fn make(blender: &Path, path: &Path, extra: &[&str]) {
-    let mut args = vec!["make", path.to_str().unwrap()];
-    args.extend(extra);
-    user_file(blender, &args);
-    assert!(path.is_file(), "{} was made", path.display());
-}
+use common::user_file::{inspect, listing, make};
 
 /// `gloffuse generate --coefficients seed --into FILE --blender B` with `extra` arguments.
 fn into(blender: &Path, file: &Path, extra: &[&str]) -> assert_cmd::assert::Assert {
@@ -45,16 +22,6 @@ fn into(blender: &Path, file: &Path, extra: &[&str]) -> assert_cmd::assert::Asse
         .arg("--no-provision")
         .args(extra)
         .assert()
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    names.sort();
-    names
 }
 
 fn stderr_of(assert: &assert_cmd::assert::Assert) -> String {
@@ -91,7 +58,7 @@ fn a_file_from_a_newer_blender_is_refused_unless_a_downgrade_is_allowed() {
         );
     }
     assert_eq!(
-        names(dir.path()),
+        listing(dir.path()),
         ["from-5.0-false.blend", "from-5.0-true.blend"],
         "nothing was written beside the files"
     );
@@ -99,7 +66,7 @@ fn a_file_from_a_newer_blender_is_refused_unless_a_downgrade_is_allowed() {
     let file = dir.path().join("from-5.0-false.blend");
     into(&new, &file, &[]).success();
     into(&old, &file, &["--allow-downgrade"]).success();
-    let saved = user_file(&old, &["inspect", file.to_str().unwrap()]);
+    let saved = inspect(&old, &file);
     assert_eq!(
         (&saved["version"][0], &saved["version"][1]),
         (&Value::from(4), &Value::from(5)),
@@ -149,11 +116,9 @@ fn the_file_keeps_its_mode_and_its_compression() {
         packed_len * 3 < plain_len,
         "compressed {packed_len} B vs uncompressed {plain_len} B with the same groups"
     );
-    let groups = user_file(&blender, &["inspect", packed.to_str().unwrap()]);
+    let groups = inspect(&blender, &packed);
     assert!(
-        groups["groups"]
-            .as_array()
-            .is_some_and(|g| g.iter().any(|n| n == "Gloffuse (GGX)")),
+        groups["groups"].get("Gloffuse (GGX)").is_some(),
         "the compressed file holds the groups: {groups}"
     );
 }
@@ -180,17 +145,22 @@ fn a_linked_file_keeps_its_relative_paths_and_its_link() {
         Path::new("../../real/scene.blend"),
         "the link is still the same link"
     );
-    assert_eq!(names(&link_dir), ["scene.blend"], "nothing beside the link");
-    assert_eq!(names(&real_dir), ["scene.blend", "scene.blend1", "tex.png"]);
-    let saved = user_file(&blender, &["inspect", real.to_str().unwrap()]);
+    assert_eq!(
+        listing(&link_dir),
+        ["scene.blend"],
+        "nothing beside the link"
+    );
+    assert_eq!(
+        listing(&real_dir),
+        ["scene.blend", "scene.blend1", "tex.png"]
+    );
+    let saved = inspect(&blender, &real);
     assert_eq!(
         saved["images"]["tex"], "//tex.png",
         "the relative path is the one the user set: {saved}"
     );
     assert!(
-        saved["groups"]
-            .as_array()
-            .is_some_and(|g| g.iter().any(|n| n == "Gloffuse (GGX)")),
+        saved["groups"].get("Gloffuse (GGX)").is_some(),
         "the groups went into the real file: {saved}"
     );
 }
@@ -235,7 +205,7 @@ fn a_failing_run_leaves_the_file_and_its_backup_as_they_were() {
             "{case}: the .blend1"
         );
         assert_eq!(
-            names(dir.path()),
+            listing(dir.path()),
             ["scene.blend", "scene.blend1"],
             "{case}: nothing left beside"
         );

@@ -1,17 +1,20 @@
-"""A user's own .blend for tests/library_file.rs, made and inspected inside
+"""A user's own .blend for tests/library_file.rs and tests/user_blend.rs, made and inspected inside
 real Blender, independently of gloffuse's package.
 
     blender -b --factory-startup -noaudio --python-exit-code 1 --python user_file.py -- \
-        --make OUT.blend [--group NAME]
+        --make OUT.blend [--group NAME] [--texture] [--compress]
     blender ... --python user_file.py -- --inspect IN.blend --out RESULT.json
     python3 user_file.py ...   (bpy module)
 
 --make saves a scene as an artist has it: a cube with the material
 "Chair Paint"; with --group, that material uses the user's own local node
-group NAME (a Value node "user value" = 0.123 wired to its output).
---inspect writes what the file holds: every local node group (its gloffuse
-tag, its node names), every material with the groups its nodes use, the
-scenes' gloffuse tags, and the number of objects.
+group NAME (a Value node "user value" = 0.123 wired to its output); with
+--texture, an Image Texture node whose image "tex" has the relative path
+//tex.png; with --compress, the file is saved compressed.
+--inspect writes what the file holds: the Blender version that saved it,
+every local node group (its gloffuse tag, its node names), every material
+with the groups its nodes use, every image's file path, the scenes' gloffuse
+tags, and the number of objects.
 """
 import argparse
 import json
@@ -26,6 +29,8 @@ def args():
     parser = argparse.ArgumentParser()
     parser.add_argument("--make")
     parser.add_argument("--group")
+    parser.add_argument("--texture", action="store_true")
+    parser.add_argument("--compress", action="store_true")
     parser.add_argument("--inspect")
     parser.add_argument("--out")
     return parser.parse_args(argv)
@@ -45,7 +50,7 @@ def user_group(name):
     return tree
 
 
-def make(path, group):
+def make(path, group, texture, compress):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     mesh = bpy.data.meshes.new("Cube")
     corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
@@ -61,7 +66,12 @@ def make(path, group):
         node = material.node_tree.nodes.new("ShaderNodeGroup")
         node.name = "user group node"
         node.node_tree = user_group(group)
-    bpy.ops.wm.save_as_mainfile(filepath=path)
+    if texture:
+        image = bpy.data.images.new("tex", 4, 4)
+        image.source = "FILE"
+        image.filepath = "//tex.png"
+        material.node_tree.nodes.new("ShaderNodeTexImage").image = image
+    bpy.ops.wm.save_as_mainfile(filepath=path, compress=compress, relative_remap=False)
 
 
 def inspect(path, out):
@@ -76,6 +86,8 @@ def inspect(path, out):
         for m in bpy.data.materials if m.node_tree is not None
     }
     report = {
+        "version": list(bpy.data.version),
+        "images": {image.name: image.filepath for image in bpy.data.images},
         "groups": groups,
         "materials": materials,
         "scene_tags": [scene.get("gloffuse") for scene in bpy.data.scenes],
@@ -89,7 +101,7 @@ def main():
     options = args()
     try:
         if options.make:
-            make(options.make, options.group)
+            make(options.make, options.group, options.texture, options.compress)
         else:
             inspect(options.inspect, options.out)
     except Exception:

@@ -1,9 +1,11 @@
 //! Helpers shared by the integration tests, one module per job: independent oracles
-//! (`oracle`), real Blenders (`blender`), and the binary itself ([`gloffuse`]).
+//! (`oracle`), real Blenders (`blender`), a user's own .blend (`user_file`), and the binary
+//! itself ([`gloffuse`]).
 #![allow(dead_code)]
 
 pub mod blender;
 pub mod oracle;
+pub mod user_file;
 
 /// The `gloffuse` binary under test.
 pub fn gloffuse() -> assert_cmd::Command {
