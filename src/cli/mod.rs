@@ -246,6 +246,7 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             emit(out, v.json, report, text::verify)?;
             Ok(verdict(report.pass))
         }
+        Command::Audit(a) => audit(&a, out, &mut stderr, &terminal),
         Command::Refresh(a) => {
             let r = gloffuse::refresh::refresh(&a.options(), &terminal)?;
             let out = summary(out, &mut stderr, &[Some(a.out.as_path())]);
@@ -271,6 +272,50 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             action: CoefficientsCommand::Show { source, json },
         } => show(source.as_deref(), json, out),
     }
+}
+
+/// `audit`: outputs checked first, then the audit, whose report folder takes each file's
+/// pictures as it is done.
+fn audit(
+    a: &args::AuditArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+    progress: &dyn Progress,
+) -> Result<Outcome> {
+    if let Some(dir) = &a.report {
+        gloffuse::report::check_dir(dir)?;
+    }
+    if let Some(path) = &a.junit {
+        check_destination(path)?;
+    }
+    let mut folder = None;
+    let report = gloffuse::audit::audit(&a.options(), progress, &mut |done| {
+        if let Some(dir) = &a.report {
+            if folder.is_none() {
+                folder = Some(gloffuse::report::audit::ReportDir::create(dir)?);
+            }
+            folder.as_mut().expect("made above").add(&done)?;
+        }
+        Ok(())
+    })?;
+    let rerun = this_command();
+    if let Some(dir) = &a.report {
+        let folder = match folder {
+            Some(f) => f,
+            None => gloffuse::report::audit::ReportDir::create(dir)?,
+        };
+        for p in folder.finish(&report, &rerun)? {
+            eprintln_quietly(&format!("wrote {}", p.display()));
+        }
+    }
+    if let Some(path) = &a.junit {
+        let xml = gloffuse::report::audit::junit::render(&report, &rerun);
+        write_output(path, xml.as_bytes())?;
+        eprintln_quietly(&format!("wrote {}", path.display()));
+    }
+    let out = summary(out, err, &[a.junit.as_deref()]);
+    emit(out, a.json, &report, gloffuse::report::audit::table::render)?;
+    Ok(verdict(report.passed))
 }
 
 /// The command line this process was started with, quoted for a shell: how to rerun it.

@@ -147,6 +147,16 @@ pub enum Field {
     Into,
     /// Whether a file saved by a newer Blender may be opened and saved by an older one.
     AllowDowngrade,
+    /// A .blend file or folder to audit.
+    AuditPath,
+    /// Which audit verdicts fail the check.
+    FailOn,
+    /// The fixed copy of one audited .blend to write.
+    Fix,
+    /// The folder for fixed copies of every audited .blend.
+    FixDir,
+    /// Fix the audited .blend files themselves.
+    InPlace,
     /// Indices of refraction.
     Ior,
     /// Where a fit's points come from (the integrator, rather than points given).
@@ -206,6 +216,11 @@ impl Field {
             Field::GModel => "masking model",
             Field::Into => "file to update",
             Field::AllowDowngrade => "permission to downgrade the file",
+            Field::AuditPath => "path to audit",
+            Field::FailOn => "verdicts that fail",
+            Field::Fix => "fixed copy",
+            Field::FixDir => "folder for fixed copies",
+            Field::InPlace => "in-place fix",
             Field::Ior => "index of refraction",
             Field::FitSource => "fit source",
             Field::Kind => "table kind",

@@ -12,7 +12,9 @@
 pub use gloffuse_physics::{error, measure, progress};
 
 pub mod albedo;
+pub mod audit;
 pub mod bench;
+pub mod blend_file;
 pub mod blender;
 pub mod fit;
 pub mod generate;

@@ -104,7 +104,7 @@ pub fn read_header(path: &Path) -> Result<BlendHeader, String> {
 }
 
 /// Fills `buf` as far as the reader goes; returns how many bytes were read.
-fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+pub(crate) fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut filled = 0;
     while filled < buf.len() {
         match reader.read(&mut buf[filled..])? {

@@ -17,6 +17,8 @@ pub enum Job {
     Generate,
     /// Build the groups, render a furnace grid and write it as an EXR (`verify`, `refresh`).
     Furnace,
+    /// Audit the materials of a user's .blend: rules, furnace and twins, and a fixed copy.
+    Audit,
 }
 
 impl Job {
@@ -25,6 +27,7 @@ impl Job {
         match self {
             Job::Generate => "generate",
             Job::Furnace => "furnace_job",
+            Job::Audit => "audit_job",
         }
     }
 }

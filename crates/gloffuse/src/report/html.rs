@@ -251,7 +251,7 @@ fn png_tag(rgb: &[u8], cell: usize) -> String {
 }
 
 /// Text for HTML: `&`, `<`, `>` and `"` escaped.
-fn escape(text: &str) -> String {
+pub(crate) fn escape(text: &str) -> String {
     text.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")

@@ -3,6 +3,7 @@
 //! and the brightness plot), `deviation` (the false-colour view), `notes` (the verdict's
 //! notes in words) — and the report folder that holds them with the rendered EXR.
 
+pub mod audit;
 pub mod deviation;
 pub mod html;
 pub mod json;

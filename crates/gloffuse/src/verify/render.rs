@@ -151,7 +151,7 @@ fn read_sweep(exr: &Path, plan: &Plan, log: &Path, command: &str) -> Result<Rgba
 }
 
 /// The highest "Sample N/M" Cycles has logged so far.
-fn last_sample(log: &Path) -> Option<u64> {
+pub(crate) fn last_sample(log: &Path) -> Option<u64> {
     let text = std::fs::read(log).ok()?;
     let text = String::from_utf8_lossy(&text);
     let at = text.rfind("Sample ")?;

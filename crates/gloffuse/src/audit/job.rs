@@ -1,0 +1,206 @@
+//! One audit job: the parameter document for one .blend, one Blender run, and its result
+//! line read back as data. The job (`blender/gloffuse_blender/audit_job.py`) opens the file
+//! (never saving it), applies the rules, renders each material beside its conserving twin
+//! in the white furnace and, when asked, saves a fixed copy.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+
+use super::rules::{RuleRange, ranges};
+use crate::Error;
+use crate::blender::{Blender, BlenderOptions, Run, RunOutput, run_script, runs};
+use crate::generate::{GenerateParams, Job, assemble};
+use crate::output::write_output;
+use crate::verify::RenderSettings;
+use crate::verify::render::last_sample;
+
+/// The `audit` section of the job's parameter document.
+#[derive(Clone, Debug, Serialize)]
+struct AuditSection {
+    file: String,
+    output: String,
+    render: bool,
+    cell: u32,
+    samples: u32,
+    seed: u32,
+    threads: u32,
+    radius_fraction: f64,
+    columns: usize,
+    fix_output: Option<String>,
+    compress: bool,
+    rules: Vec<RuleRange>,
+}
+
+/// The job's parameter document: the generate fields (the groups twins may need), flattened,
+/// plus `audit`.
+#[derive(Serialize)]
+struct AuditParams<'a> {
+    #[serde(flatten)]
+    generate: &'a GenerateParams,
+    audit: AuditSection,
+}
+
+/// A finding as the job reports it.
+#[derive(Clone, Debug, Deserialize)]
+pub struct JobFinding {
+    pub rule: String,
+    pub node: Vec<String>,
+    #[serde(default)]
+    pub node_type: String,
+    #[serde(default)]
+    pub detail: serde_json::Value,
+    #[serde(default)]
+    pub twin: Option<String>,
+}
+
+/// A material as the job reports it.
+#[derive(Clone, Debug, Deserialize)]
+pub struct JobMaterial {
+    pub name: String,
+    #[serde(default)]
+    pub library: Option<String>,
+    #[serde(default)]
+    pub cell: Option<usize>,
+    #[serde(default)]
+    pub twin_cell: Option<usize>,
+    #[serde(default)]
+    pub replaced: usize,
+    #[serde(default)]
+    pub findings: Vec<JobFinding>,
+    #[serde(default)]
+    pub error: Option<String>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+pub struct JobFixed {
+    pub path: String,
+    pub replaced: usize,
+}
+
+/// The job's result line.
+#[derive(Clone, Debug, Deserialize)]
+pub struct JobResult {
+    #[serde(default)]
+    pub output: Option<String>,
+    #[serde(default)]
+    pub columns: Option<usize>,
+    #[serde(default)]
+    pub render_seconds: Option<f64>,
+    #[serde(default)]
+    pub file_findings: Vec<JobFinding>,
+    pub materials: Vec<JobMaterial>,
+    #[serde(default)]
+    pub fixed: Option<JobFixed>,
+}
+
+/// What one job run needs besides the file.
+pub struct JobSettings<'a> {
+    pub blender: &'a Blender,
+    pub options: &'a BlenderOptions,
+    pub groups: &'a GenerateParams,
+    pub render: Option<RenderSettings>,
+    /// About how many materials the file holds (for the grid's shape).
+    pub materials: usize,
+    /// Told the fraction of the render done (from the samples Cycles logs) while it runs.
+    pub on_fraction: &'a (dyn Fn(f64) + Sync),
+}
+
+/// A finished job: its result, its log, and the EXR when it rendered.
+pub struct JobRun {
+    pub result: JobResult,
+    pub log: PathBuf,
+    pub exr: Option<PathBuf>,
+}
+
+/// Columns of a grid of `cells` cells, about as wide as high.
+fn columns_for(cells: usize) -> usize {
+    (cells.max(1) as f64).sqrt().ceil() as usize
+}
+
+/// Runs the audit job on `file` (its real path); with `fix_output`, the job also saves the
+/// fixed copy there (compressed when `compress`).
+pub fn run_job(
+    s: &JobSettings,
+    file: &Path,
+    fix_output: Option<&Path>,
+    compress: bool,
+) -> Result<JobRun, Error> {
+    let run_dir = runs::new_run_dir("audit")?;
+    let exr = run_dir.join("audit.exr");
+    let render = s.render.unwrap_or_default();
+    let section = AuditSection {
+        file: file.to_string_lossy().into_owned(),
+        output: exr.to_string_lossy().into_owned(),
+        render: s.render.is_some(),
+        cell: render.cell,
+        samples: render.samples,
+        seed: render.seed,
+        threads: 0,
+        radius_fraction: render.radius_fraction,
+        // A material and its twin per material, at most.
+        columns: columns_for(2 * s.materials),
+        fix_output: fix_output.map(|p| p.to_string_lossy().into_owned()),
+        compress,
+        rules: ranges(),
+    };
+    let params = AuditParams {
+        generate: s.groups,
+        audit: section,
+    };
+    let script = run_dir.join("gloffuse-audit.py");
+    write_output(&script, assemble(&params, Job::Audit).as_bytes())?;
+    let log = run_dir.join("blender.log");
+    let run = Run {
+        blender: s.blender,
+        script: &script,
+        args: Vec::new(),
+        timeout: s.options.timeout,
+        cancel: s.options.cancel.clone(),
+        log: log.clone(),
+    };
+    let out = followed(&run, render.samples, s.on_fraction)?;
+    let result: JobResult = serde_json::from_value(out.result).map_err(|e| Error::Blender {
+        message: format!("the audit job's result line is not what gloffuse expects ({e})").into(),
+        log: Some(log.clone()),
+        command: None,
+    })?;
+    let exr = (s.render.is_some() && result.output.is_some()).then_some(exr);
+    Ok(JobRun { result, log, exr })
+}
+
+/// Runs `run` while a watcher reports the fraction of `samples` Cycles has logged.
+fn followed(
+    run: &Run,
+    samples: u32,
+    on_fraction: &(dyn Fn(f64) + Sync),
+) -> Result<RunOutput, Error> {
+    let done = AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !done.load(Ordering::Relaxed) {
+                if let Some(n) = last_sample(&run.log) {
+                    on_fraction(n as f64 / f64::from(samples.max(1)));
+                }
+                std::thread::sleep(Duration::from_millis(200));
+            }
+        });
+        let outcome = run_script(run);
+        done.store(true, Ordering::Relaxed);
+        outcome
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_grid_is_about_square() {
+        assert_eq!(columns_for(0), 1);
+        assert_eq!(columns_for(2), 2);
+        assert_eq!(columns_for(200), 15);
+    }
+}

@@ -1,0 +1,213 @@
+//! From a job's result and its rendered grid to verdicts: each material's brightness and its
+//! twin's, its findings worded from the catalogue, and `ok`, `loses`, `creates` or `error`.
+
+use super::job::{JobFinding, JobMaterial};
+use super::rules::{Effect, Predictor, rule};
+use super::verdict::{AuditJudging, AuditedMaterial, Brightness, Finding, Verdict};
+use crate::verify::image::Rgba;
+use crate::verify::stats::{SphereStats, sphere_stats};
+
+/// Standard errors a difference may be off by noise alone before it counts.
+const NOISE_SIGMAS: f64 = 3.0;
+
+/// A sphere covering less of its disc than this rendered nothing to measure (a holdout, a
+/// fully transparent material).
+const MIN_COVERAGE: f64 = 0.5;
+
+/// The rendered grid of one file.
+pub struct Grid<'a> {
+    pub image: &'a Rgba,
+    pub columns: usize,
+    pub cell: usize,
+    pub radius_fraction: f64,
+}
+
+impl Grid<'_> {
+    fn brightness(&self, index: usize) -> Option<Brightness> {
+        let s: SphereStats = sphere_stats(
+            self.image,
+            index,
+            self.columns,
+            self.cell,
+            self.radius_fraction,
+        );
+        if !(s.coverage >= MIN_COVERAGE) || !s.mean.is_finite() {
+            return None;
+        }
+        let rings = s.rings.iter().map(|r| r.mean).filter(|m| m.is_finite());
+        Some(Brightness {
+            mean: s.mean,
+            center: s.center,
+            rim: s.rings.last().map_or(f64::NAN, |r| r.mean),
+            max_ring: rings.fold(f64::NEG_INFINITY, f64::max),
+            standard_error: s.standard_error,
+        })
+    }
+}
+
+/// A job's finding in words: the catalogue's why and fix, the rule's versions, and the
+/// integrator's prediction where it knows the lobe.
+pub fn word(f: &JobFinding, predictor: &mut Predictor) -> Finding {
+    let known = rule(&f.rule);
+    let predicted = predictor.predict(&f.rule, &f.detail);
+    let mut why = known.map_or_else(
+        || "a rule this gloffuse does not know".to_string(),
+        |r| r.why.to_string(),
+    );
+    if let Some(p) = predicted {
+        why.push_str(&format!(
+            "; the integrator predicts {:.1} % for this lobe",
+            100.0 * p
+        ));
+    }
+    Finding {
+        rule: f.rule.clone(),
+        node: f.node.join(" ▸ "),
+        node_path: f.node.clone(),
+        node_type: f.node_type.clone(),
+        kind: known.map_or(Effect::Info, |r| r.effect),
+        versions: known.map_or_else(String::new, |r| r.versions()),
+        why,
+        fix: known.map_or_else(String::new, |r| r.fix.to_string()),
+        predicted,
+        twin: f.twin.clone(),
+        detail: f.detail.clone(),
+    }
+}
+
+fn pct(x: f64) -> String {
+    format!("{:.1} %", 100.0 * x)
+}
+
+/// The verdict on one material of `file`.
+pub fn judge_material(
+    file: &str,
+    m: &JobMaterial,
+    grid: Option<&Grid>,
+    judging: &AuditJudging,
+    predictor: &mut Predictor,
+) -> AuditedMaterial {
+    let findings: Vec<Finding> = m.findings.iter().map(|f| word(f, predictor)).collect();
+    let cells = m.cell.map(|c| (c, m.twin_cell.unwrap_or(c)));
+    let measured = grid
+        .zip(cells)
+        .map(|(g, (c, t))| (g.brightness(c), g.brightness(t)));
+    let (verdict, reason) = verdict(m, &findings, measured, judging);
+    let own = measured.and_then(|(b, _)| b);
+    let twin = measured.and_then(|(_, t)| t);
+    AuditedMaterial {
+        file: file.to_string(),
+        material: m.name.clone(),
+        verdict,
+        reason,
+        mean: own.map(|b| b.mean),
+        center: own.map(|b| b.center),
+        rim: own.map(|b| b.rim),
+        twin_mean: twin.map(|b| b.mean),
+        twin_center: twin.map(|b| b.center),
+        twin_rim: twin.map(|b| b.rim),
+        replaced: m.replaced,
+        findings,
+        library: m.library.clone(),
+        cells,
+        after: None,
+    }
+}
+
+type Measured = Option<(Option<Brightness>, Option<Brightness>)>;
+
+fn verdict(
+    m: &JobMaterial,
+    findings: &[Finding],
+    measured: Measured,
+    judging: &AuditJudging,
+) -> (Verdict, String) {
+    if let Some(error) = &m.error {
+        return (Verdict::Error, error.clone());
+    }
+    if let Some(f) = findings.iter().find(|f| f.kind == Effect::Error) {
+        return (Verdict::Error, format!("{} ({})", f.rule, f.node));
+    }
+    match measured {
+        None => by_rules(findings, judging),
+        Some((None, _)) | Some((_, None)) => (
+            Verdict::Error,
+            "nothing rendered to measure (a holdout, or fully transparent)".to_string(),
+        ),
+        Some((Some(own), Some(twin))) => by_furnace(findings, own, twin, judging),
+    }
+}
+
+/// Without a render: a creating finding creates; a losing one loses unless the integrator
+/// predicts the loss within the tolerance.
+fn by_rules(findings: &[Finding], judging: &AuditJudging) -> (Verdict, String) {
+    if let Some(f) = findings.iter().find(|f| f.kind == Effect::Creates) {
+        return (Verdict::Creates, format!("{} at {}", f.rule, f.node));
+    }
+    let losing = findings.iter().find(|f| {
+        f.kind == Effect::Loses && f.predicted.is_none_or(|p| 1.0 - p > judging.tolerance)
+    });
+    match losing {
+        Some(f) => (Verdict::Loses, format!("{} at {}", f.rule, f.node)),
+        None => (
+            Verdict::Ok,
+            "no rule fired beyond the tolerance (not rendered)".to_string(),
+        ),
+    }
+}
+
+fn by_furnace(
+    findings: &[Finding],
+    own: Brightness,
+    twin: Brightness,
+    j: &AuditJudging,
+) -> (Verdict, String) {
+    let emits = findings.iter().any(|f| f.rule == "emission");
+    let mean_limit = 1.0 + j.tolerance + NOISE_SIGMAS * own.standard_error;
+    if !emits && (own.mean > mean_limit || own.max_ring > 1.0 + j.ring_tolerance) {
+        return (
+            Verdict::Creates,
+            format!(
+                "renders at {} (brightest ring {}): above 100 % in a white furnace",
+                pct(own.mean),
+                pct(own.max_ring)
+            ),
+        );
+    }
+    let noise = NOISE_SIGMAS * own.standard_error.hypot(twin.standard_error);
+    if twin.mean - own.mean > j.tolerance + noise {
+        return (
+            Verdict::Loses,
+            format!(
+                "renders at {}; its conserving twin at {}",
+                pct(own.mean),
+                pct(twin.mean)
+            ),
+        );
+    }
+    // A loss with no conserving node to compare with is judged by the integrator alone.
+    let untwinned = findings.iter().find(|f| {
+        f.kind == Effect::Loses
+            && f.twin.is_none()
+            && f.predicted.is_none_or(|p| 1.0 - p > j.tolerance)
+    });
+    if let Some(f) = untwinned {
+        return (
+            Verdict::Loses,
+            format!(
+                "renders at {}; {} at {} has no conserving equivalent in this Blender",
+                pct(own.mean),
+                f.rule,
+                f.node
+            ),
+        );
+    }
+    (
+        Verdict::Ok,
+        format!(
+            "renders at {}; its conserving twin at {}",
+            pct(own.mean),
+            pct(twin.mean)
+        ),
+    )
+}

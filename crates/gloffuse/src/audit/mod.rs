@@ -1,0 +1,446 @@
+//! ⑤ Audit: the user's own materials. For every material of every .blend given, the rules
+//! (nodes Cycles leaves uncompensated in that Blender, nodes that create energy), then a
+//! white-furnace render of the material as authored beside its conserving twin, one Blender
+//! process per file; optionally a fixed copy (or the file itself, through the one safe
+//! path, `user_blend`), audited again. Files are streamed: each file's grid is handed to the
+//! caller and dropped before the next file starts.
+
+pub mod files;
+pub mod job;
+pub mod judge;
+pub mod rules;
+pub mod verdict;
+
+pub use verdict::{
+    After, AuditJudging, AuditReport, AuditSettings, AuditedFile, AuditedMaterial, Counts, Finding,
+    Fixed, Verdict,
+};
+
+use std::path::{Path, PathBuf};
+
+use crate::blend_file::{MATERIAL, count_blocks};
+use crate::blender::{Blender, BlenderOptions};
+use crate::fit::Coefficients;
+use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
+use crate::measure::Engine;
+use crate::output::{check_destination, temp_beside};
+use crate::progress::Progress;
+use crate::user_blend::{UserBlend, read_header};
+use crate::verify::RenderSettings;
+use crate::verify::image::{Rgba, read_rgba};
+use crate::{Error, Field, Hint};
+use job::{JobRun, JobSettings, run_job};
+use judge::{Grid, judge_material};
+use rules::Predictor;
+
+/// Where fixed files go.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum FixTarget {
+    #[default]
+    None,
+    /// One input's fixed copy.
+    File(PathBuf),
+    /// Every input's fixed copy, under its path relative to the folder it was found in.
+    Dir(PathBuf),
+    /// The inputs themselves (each keeps its previous version as `FILE.blend1`).
+    InPlace,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct AuditOptions {
+    pub paths: Vec<PathBuf>,
+    /// Render the furnace (else rules only).
+    pub render: bool,
+    pub settings: RenderSettings,
+    pub judging: AuditJudging,
+    pub fix: FixTarget,
+    pub allow_downgrade: bool,
+    pub blender: BlenderOptions,
+}
+
+impl Default for AuditOptions {
+    fn default() -> Self {
+        AuditOptions {
+            paths: Vec::new(),
+            render: true,
+            settings: RenderSettings::default(),
+            judging: AuditJudging::default(),
+            fix: FixTarget::None,
+            allow_downgrade: false,
+            blender: BlenderOptions::default(),
+        }
+    }
+}
+
+/// One audited file, as handed to the caller while the audit goes on: its grid is only
+/// alive for the call.
+pub struct FileDone<'a> {
+    pub file: &'a AuditedFile,
+    pub materials: &'a [AuditedMaterial],
+    pub image: Option<&'a Rgba>,
+}
+
+/// Audits every material of the .blend files under `o.paths`; `on_file` sees each file as it
+/// is done (the report's pictures are made there, so grids never pile up in memory).
+pub fn audit(
+    o: &AuditOptions,
+    progress: &dyn Progress,
+    on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
+) -> Result<AuditReport, Error> {
+    check(o)?;
+    let files = files::blend_files(&o.paths)?;
+    let blender = o.blender.find(progress)?;
+    let fix_targets = fix_targets(o, &files, &blender)?;
+    let groups = twin_groups(&blender)?;
+    let counts: Vec<usize> = files
+        .iter()
+        .map(|f| count_blocks(f, MATERIAL).unwrap_or(1))
+        .collect();
+    let mut report = empty_report(o, &blender);
+    let mut predictor = Predictor::new(blender.version);
+    let total: usize = counts.iter().sum();
+    progress.begin(
+        &format!(
+            "auditing {total} materials in {} files with Blender {}",
+            files.len(),
+            blender.version_string
+        ),
+        total as u64,
+    );
+    let mut done = 0u64;
+    for ((file, materials), fix) in files.iter().zip(&counts).zip(&fix_targets) {
+        let settings = JobSettings {
+            blender: &blender,
+            options: &o.blender,
+            groups: &groups,
+            render: o.render.then_some(o.settings),
+            materials: *materials,
+            on_fraction: &|f: f64| progress.set(done + (f.min(1.0) * *materials as f64) as u64),
+        };
+        let (audited_file, mut materials_done, image) =
+            match audit_file(&settings, file, fix.as_ref(), o, &mut predictor) {
+                Err(e @ Error::Interrupted { .. }) => {
+                    progress.end();
+                    return Err(e);
+                }
+                Err(e) => (failed_file(file, &e), Vec::new(), None),
+                Ok(ok) => ok,
+            };
+        if let Some(fixed) = &audited_file.fixed {
+            match after(&settings, Path::new(&fixed.path), o, &mut predictor) {
+                Err(e @ Error::Interrupted { .. }) => {
+                    progress.end();
+                    return Err(e);
+                }
+                Err(_) => {}
+                Ok(after) => attach_after(&mut materials_done, after),
+            }
+        }
+        on_file(FileDone {
+            file: &audited_file,
+            materials: &materials_done,
+            image: image.as_ref(),
+        })?;
+        report.files.push(audited_file);
+        report.materials.extend(materials_done);
+        done += *materials as u64;
+        progress.set(done);
+    }
+    progress.end();
+    report.finish();
+    Ok(report)
+}
+
+/// The report before any file: how the audit runs and judges.
+fn empty_report(o: &AuditOptions, blender: &Blender) -> AuditReport {
+    AuditReport {
+        gloffuse_version: env!("CARGO_PKG_VERSION").to_string(),
+        blender_version: blender.version_string.clone(),
+        blender_program: blender.program.display().to_string(),
+        settings: AuditSettings {
+            cell: o.settings.cell,
+            samples: o.settings.samples,
+            seed: o.settings.seed,
+            render: o.render,
+            tolerance: o.judging.tolerance,
+            ring_tolerance: o.judging.ring_tolerance,
+            fail_on: o.judging.fail_on.clone(),
+        },
+        passed: false,
+        counts: Counts::default(),
+        files: Vec::new(),
+        materials: Vec::new(),
+    }
+}
+
+fn check(o: &AuditOptions) -> Result<(), Error> {
+    for (value, what) in [
+        (o.judging.tolerance, "tolerance"),
+        (o.judging.ring_tolerance, "ring tolerance"),
+    ] {
+        if !(0.0..1.0).contains(&value) {
+            return Err(Error::input(
+                Field::Arguments,
+                value,
+                format!("a {what} from 0 to 100 %"),
+            ));
+        }
+    }
+    if let FixTarget::File(out) = &o.fix {
+        check_destination(out)?;
+    }
+    Ok(())
+}
+
+/// How one file's fix is written.
+struct FixPlan {
+    /// The input, checked (its header: version and compression).
+    input: UserBlend,
+    /// Where the fixed file goes; `None`: the input itself.
+    dest: Option<PathBuf>,
+}
+
+/// Each file's fix plan, checked before any render: one input for `--fix`, never the input
+/// itself as a copy, and no file saved by a newer Blender unless a downgrade is allowed.
+fn fix_targets(
+    o: &AuditOptions,
+    files: &[PathBuf],
+    blender: &Blender,
+) -> Result<Vec<Option<FixPlan>>, Error> {
+    let field = match &o.fix {
+        FixTarget::None => return Ok(files.iter().map(|_| None).collect()),
+        FixTarget::File(_) => Field::Fix,
+        FixTarget::Dir(_) => Field::FixDir,
+        FixTarget::InPlace => Field::InPlace,
+    };
+    if let FixTarget::File(out) = &o.fix
+        && files.len() != 1
+    {
+        return Err(Error::input(
+            Field::Fix,
+            out.display(),
+            Hint::new(
+                format!(
+                    "one input .blend ({} were found): for several, use {{}}",
+                    files.len()
+                ),
+                [Field::FixDir],
+            ),
+        ));
+    }
+    files
+        .iter()
+        .map(|file| {
+            let input = UserBlend::open(file, field, blender.version, o.allow_downgrade)?;
+            let dest = match &o.fix {
+                FixTarget::File(out) => Some(out.clone()),
+                FixTarget::Dir(dir) => Some(dir.join(relative_to_root(file, &o.paths))),
+                _ => None,
+            };
+            if let Some(dest) = &dest
+                && std::fs::canonicalize(dest).is_ok_and(|d| d == input.real)
+            {
+                return Err(Error::input(
+                    field,
+                    dest.display(),
+                    Hint::new(
+                        "a path other than the audited file (to fix the file itself, use {})",
+                        [Field::InPlace],
+                    ),
+                ));
+            }
+            Ok(Some(FixPlan { input, dest }))
+        })
+        .collect()
+}
+
+/// `file`'s path below the folder it was found in (its name, when it was named itself).
+fn relative_to_root(file: &Path, roots: &[PathBuf]) -> PathBuf {
+    roots
+        .iter()
+        .filter(|r| r.is_dir())
+        .find_map(|r| file.strip_prefix(r).ok())
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| file.file_name().map(PathBuf::from).unwrap_or_default())
+}
+
+/// The groups a twin may use: gloffuse's multiscatter and layered groups for this Blender.
+fn twin_groups(blender: &Blender) -> Result<GenerateParams, Error> {
+    let (coefficients, source) =
+        Coefficients::load_or_preset(None, Engine::Cycles, blender.version)?;
+    GenerateParams::new(
+        Curves::Pinned {
+            coefficients: &coefficients,
+            name: &source,
+        },
+        &[blender.version.masking()],
+        &[Mode::Multiscatter, Mode::Layered],
+        ColorModel::Exact,
+    )
+}
+
+type FileAudit = (AuditedFile, Vec<AuditedMaterial>, Option<Rgba>);
+
+fn audit_file(
+    s: &JobSettings,
+    file: &Path,
+    fix: Option<&FixPlan>,
+    o: &AuditOptions,
+    predictor: &mut Predictor,
+) -> Result<FileAudit, Error> {
+    let real = std::fs::canonicalize(file).map_err(|source| Error::Read {
+        path: file.to_path_buf(),
+        source,
+    })?;
+    let temp = match fix {
+        None => None,
+        Some(FixPlan { input, dest: None }) => Some(input.temp()?),
+        Some(FixPlan {
+            dest: Some(dest), ..
+        }) => {
+            if let Some(dir) = dest.parent() {
+                std::fs::create_dir_all(dir).map_err(|e| Error::Write {
+                    path: dir.to_path_buf(),
+                    message: e.to_string(),
+                })?;
+            }
+            Some(temp_beside(dest, ".blend")?)
+        }
+    };
+    let compress = fix.is_some_and(|f| f.input.compressed());
+    let job = run_job(s, &real, temp.as_deref(), compress)?;
+    let image = job.exr.as_deref().map(read_grid).transpose()?;
+    let (file_entry, materials) = judged(file, &job, image.as_ref(), o, predictor);
+    let mut file_entry = file_entry;
+    if let (Some(fix), Some(temp), Some(fixed)) = (fix, temp, &job.result.fixed) {
+        file_entry.fixed = install_fix(fix, temp, fixed.replaced)?;
+    }
+    Ok((file_entry, materials, image))
+}
+
+fn read_grid(exr: &Path) -> Result<Rgba, Error> {
+    read_rgba(exr).map_err(|e| Error::Blender {
+        message: format!("{}: {e}", exr.display()).into(),
+        log: None,
+        command: None,
+    })
+}
+
+/// The file's entry and its materials' verdicts.
+fn judged(
+    file: &Path,
+    job: &JobRun,
+    image: Option<&Rgba>,
+    o: &AuditOptions,
+    predictor: &mut Predictor,
+) -> (AuditedFile, Vec<AuditedMaterial>) {
+    let cell = o.settings.cell as usize;
+    let columns = job.result.columns.unwrap_or(1).max(1);
+    let grid = image.map(|image| Grid {
+        image,
+        columns,
+        cell,
+        radius_fraction: o.settings.radius_fraction,
+    });
+    let name = file.display().to_string();
+    let materials = job
+        .result
+        .materials
+        .iter()
+        .map(|m| judge_material(&name, m, grid.as_ref(), &o.judging, predictor))
+        .collect();
+    let entry = AuditedFile {
+        file: name,
+        saved_by: read_header(file)
+            .ok()
+            .and_then(|h| h.version)
+            .map(|v| v.to_string()),
+        error: None,
+        findings: job
+            .result
+            .file_findings
+            .iter()
+            .map(|f| judge::word(f, predictor))
+            .collect(),
+        materials: job.result.materials.len(),
+        log: Some(job.log.display().to_string()),
+        render_seconds: job.result.render_seconds,
+        grid: image.map(|_| (columns, cell)),
+        fixed: None,
+    };
+    (entry, materials)
+}
+
+/// Puts a fixed file in place: a copy renamed to its destination, or the input replaced
+/// through `UserBlend::install` (its previous version kept as `.blend1`). An in-place fix
+/// that replaced nothing leaves the file alone.
+fn install_fix(
+    fix: &FixPlan,
+    temp: tempfile::TempPath,
+    replaced: usize,
+) -> Result<Option<Fixed>, Error> {
+    match &fix.dest {
+        None if replaced == 0 => Ok(None),
+        None => {
+            let backup = fix.input.install(temp)?;
+            Ok(Some(Fixed {
+                path: fix.input.real.display().to_string(),
+                replaced,
+                backup: Some(backup.display().to_string()),
+            }))
+        }
+        Some(dest) => {
+            temp.persist(dest).map_err(|e| Error::Write {
+                path: dest.clone(),
+                message: e.error.to_string(),
+            })?;
+            Ok(Some(Fixed {
+                path: dest.display().to_string(),
+                replaced,
+                backup: None,
+            }))
+        }
+    }
+}
+
+/// The fixed file audited again.
+fn after(
+    s: &JobSettings,
+    fixed: &Path,
+    o: &AuditOptions,
+    predictor: &mut Predictor,
+) -> Result<Vec<AuditedMaterial>, Error> {
+    let job = run_job(s, fixed, None, false)?;
+    let image = job.exr.as_deref().map(read_grid).transpose()?;
+    Ok(judged(fixed, &job, image.as_ref(), o, predictor).1)
+}
+
+fn attach_after(materials: &mut [AuditedMaterial], after: Vec<AuditedMaterial>) {
+    for m in materials {
+        m.after = after
+            .iter()
+            .find(|a| a.material == m.material)
+            .map(|a| After {
+                verdict: a.verdict,
+                mean: a.mean,
+                findings: a.findings.len(),
+            });
+    }
+}
+
+fn failed_file(file: &Path, e: &Error) -> AuditedFile {
+    AuditedFile {
+        file: file.display().to_string(),
+        saved_by: read_header(file)
+            .ok()
+            .and_then(|h| h.version)
+            .map(|v| v.to_string()),
+        error: Some(e.to_string()),
+        findings: Vec::new(),
+        materials: 0,
+        log: None,
+        render_seconds: None,
+        grid: None,
+        fixed: None,
+    }
+}

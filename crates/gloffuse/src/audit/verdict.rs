@@ -1,0 +1,207 @@
+//! The audit's verdict as data: one [`AuditedMaterial`] per material, its [`Finding`]s,
+//! the files, the counts and whether the check passed.
+
+use serde::Serialize;
+
+use super::rules::Effect;
+
+/// What the furnace and the rules say about one material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// It creates energy: brighter than the light it receives.
+    Creates,
+    /// It loses energy its conserving twin keeps.
+    Loses,
+    /// It could not be audited as authored.
+    Error,
+    Ok,
+}
+
+impl Verdict {
+    pub const ALL: [Verdict; 4] = [
+        Verdict::Ok,
+        Verdict::Loses,
+        Verdict::Creates,
+        Verdict::Error,
+    ];
+
+    pub fn key(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Loses => "loses",
+            Verdict::Creates => "creates",
+            Verdict::Error => "error",
+        }
+    }
+}
+
+/// Thresholds of the furnace verdict.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AuditJudging {
+    /// Allowed excess of the mean over 1, and of the twin's mean over the material's (0.01 = 1 %).
+    pub tolerance: f64,
+    /// Allowed excess of a ring's mean over 1.
+    pub ring_tolerance: f64,
+    /// The verdicts that fail the check.
+    pub fail_on: Vec<Verdict>,
+}
+
+impl Default for AuditJudging {
+    fn default() -> Self {
+        AuditJudging {
+            tolerance: 0.01,
+            ring_tolerance: 0.03,
+            fail_on: vec![Verdict::Loses, Verdict::Creates, Verdict::Error],
+        }
+    }
+}
+
+/// One flagged node.
+#[derive(Clone, Debug, Serialize)]
+pub struct Finding {
+    pub rule: String,
+    /// `Material ▸ Group node ▸ Node`.
+    pub node: String,
+    pub node_path: Vec<String>,
+    pub node_type: String,
+    pub kind: Effect,
+    /// The Blender versions the rule applies to.
+    pub versions: String,
+    pub why: String,
+    pub fix: String,
+    /// The lobe's brightness the integrator predicts (1.0 = 100 %), where it is known.
+    pub predicted: Option<f64>,
+    /// What the conserving twin put in the node's place; none: nothing conserving exists.
+    pub twin: Option<String>,
+    /// What the job read off the node (distribution, roughness, …).
+    pub detail: serde_json::Value,
+}
+
+/// Furnace brightness of one sphere (1.0 = 100 %).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Brightness {
+    pub mean: f64,
+    pub center: f64,
+    /// The outermost view-cosine ring.
+    pub rim: f64,
+    /// The brightest ring.
+    pub max_ring: f64,
+    pub standard_error: f64,
+}
+
+/// The after-fix audit of a material.
+#[derive(Clone, Debug, Serialize)]
+pub struct After {
+    pub verdict: Verdict,
+    pub mean: Option<f64>,
+    pub findings: usize,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct AuditedMaterial {
+    pub file: String,
+    pub material: String,
+    pub verdict: Verdict,
+    /// Why, in words.
+    pub reason: String,
+    pub mean: Option<f64>,
+    pub center: Option<f64>,
+    pub rim: Option<f64>,
+    pub twin_mean: Option<f64>,
+    pub twin_center: Option<f64>,
+    pub twin_rim: Option<f64>,
+    /// How many lobes the twin replaced.
+    pub replaced: usize,
+    pub findings: Vec<Finding>,
+    /// The library it is linked from, as the file writes it.
+    pub library: Option<String>,
+    /// Its cell and its twin's in the file's rendered grid.
+    #[serde(skip)]
+    pub cells: Option<(usize, usize)>,
+    pub after: Option<After>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Fixed {
+    pub path: String,
+    pub replaced: usize,
+    /// With `--in-place`: where the previous version was kept.
+    pub backup: Option<String>,
+}
+
+/// One audited .blend.
+#[derive(Clone, Debug, Serialize)]
+pub struct AuditedFile {
+    pub file: String,
+    /// The Blender version that saved it, from its header.
+    pub saved_by: Option<String>,
+    /// Why the file could not be audited (its materials are then missing from the report).
+    pub error: Option<String>,
+    /// Findings of the file as a whole (its scenes' settings).
+    pub findings: Vec<Finding>,
+    pub materials: usize,
+    pub log: Option<String>,
+    pub render_seconds: Option<f64>,
+    /// The rendered grid's columns and cell size, for pictures.
+    #[serde(skip)]
+    pub grid: Option<(usize, usize)>,
+    pub fixed: Option<Fixed>,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Counts {
+    pub files: usize,
+    pub materials: usize,
+    pub ok: usize,
+    pub loses: usize,
+    pub creates: usize,
+    pub error: usize,
+}
+
+/// How the materials were rendered.
+#[derive(Clone, Debug, Serialize)]
+pub struct AuditSettings {
+    pub cell: u32,
+    pub samples: u32,
+    pub seed: u32,
+    pub render: bool,
+    pub tolerance: f64,
+    pub ring_tolerance: f64,
+    pub fail_on: Vec<Verdict>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct AuditReport {
+    pub gloffuse_version: String,
+    pub blender_version: String,
+    pub blender_program: String,
+    pub settings: AuditSettings,
+    pub passed: bool,
+    pub counts: Counts,
+    pub files: Vec<AuditedFile>,
+    pub materials: Vec<AuditedMaterial>,
+}
+
+impl AuditReport {
+    /// Counts the verdicts and decides `passed` (no file error, no verdict in `fail_on`).
+    pub fn finish(&mut self) {
+        let mut counts = Counts {
+            files: self.files.len(),
+            materials: self.materials.len(),
+            ..Counts::default()
+        };
+        for m in &self.materials {
+            *match m.verdict {
+                Verdict::Ok => &mut counts.ok,
+                Verdict::Loses => &mut counts.loses,
+                Verdict::Creates => &mut counts.creates,
+                Verdict::Error => &mut counts.error,
+            } += 1;
+        }
+        let fails = |v: Verdict| self.settings.fail_on.contains(&v);
+        let file_failed = self.files.iter().any(|f| f.error.is_some()) && fails(Verdict::Error);
+        self.passed = !file_failed && !self.materials.iter().any(|m| fails(m.verdict));
+        self.counts = counts;
+    }
+}

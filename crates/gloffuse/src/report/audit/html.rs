@@ -1,0 +1,124 @@
+//! The audit verdict as one HTML page: a summary, then one card per material (failures
+//! first) with its picture (as authored | conserving twin | difference), its numbers and
+//! its findings with their fixes.
+
+use crate::audit::{AuditReport, AuditedMaterial};
+use crate::report::audit::table::order;
+use crate::report::html::escape;
+
+fn pct(x: Option<f64>) -> String {
+    x.map_or_else(|| "—".to_string(), |x| format!("{:.1} %", 100.0 * x))
+}
+
+/// `pictures[i]` is material i's picture (report order), relative to the page.
+pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) -> String {
+    let c = &report.counts;
+    let mut s = String::from(
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>gloffuse audit</title><style>\
+         body{font:14px/1.4 system-ui,sans-serif;margin:2em;max-width:70em}\
+         .card{border:1px solid #ccc;border-radius:6px;padding:.8em;margin:.8em 0}\
+         .creates{border-left:6px solid #b2182b}.loses{border-left:6px solid #2166ac}\
+         .error{border-left:6px solid #777}.ok{border-left:6px solid #1a9850}\
+         img{image-rendering:pixelated;width:384px;display:block;margin:.4em 0}\
+         .cap{display:flex;width:384px;font-size:12px;color:#555}.cap span{flex:1;text-align:center}\
+         code{background:#f4f4f4;padding:0 .2em}</style></head><body>\n",
+    );
+    s.push_str(&format!(
+        "<h1>gloffuse audit: {}</h1>\n<p>{} materials in {} files, Blender {}, {} px, {} spp: \
+         <b>{} ok</b>, {} lose energy, {} create energy, {} errors. The check fails on: {}. \
+         Each picture shows the material as authored in a white furnace (a uniformly lit white \
+         world: a material that neither loses nor creates energy renders at 100 % of its \
+         colour), its energy-conserving twin, and their difference (blue: darker than the \
+         twin, red: brighter; ±5 % at full colour).</p>\n<p>Rerun: <code>{}</code></p>\n",
+        if report.passed { "PASS" } else { "FAIL" },
+        c.materials,
+        c.files,
+        escape(&report.blender_version),
+        report.settings.cell,
+        report.settings.samples,
+        c.ok,
+        c.loses,
+        c.creates,
+        c.error,
+        report
+            .settings
+            .fail_on
+            .iter()
+            .map(|v| v.key())
+            .collect::<Vec<_>>()
+            .join(", "),
+        escape(rerun)
+    ));
+    for f in report.files.iter().filter(|f| f.error.is_some()) {
+        s.push_str(&format!(
+            "<div class=\"card error\"><b>{}</b>: {}</div>\n",
+            escape(&f.file),
+            escape(f.error.as_deref().unwrap_or_default())
+        ));
+    }
+    for m in order(report) {
+        let index = report
+            .materials
+            .iter()
+            .position(|o| std::ptr::eq(o, m))
+            .expect("ordered from the report");
+        s.push_str(&card(m, pictures.get(index).cloned().flatten()));
+    }
+    s.push_str("</body></html>\n");
+    s
+}
+
+fn card(m: &AuditedMaterial, picture: Option<String>) -> String {
+    let mut s = format!(
+        "<div class=\"card {v}\"><h3>{v}: {} <small>({})</small></h3>\n<p>{}</p>\n",
+        escape(&m.material),
+        escape(&m.file),
+        escape(&m.reason),
+        v = m.verdict.key()
+    );
+    if let Some(p) = picture {
+        s.push_str(&format!(
+            "<img src=\"{}\" alt=\"{} as authored, its twin, their difference\">\
+             <div class=\"cap\"><span>as authored</span><span>twin</span><span>difference</span></div>\n",
+            escape(&p),
+            escape(&m.material)
+        ));
+    }
+    s.push_str(&format!(
+        "<p>mean {}, centre {}, rim {}; twin {} (centre {}, rim {})</p>\n",
+        pct(m.mean),
+        pct(m.center),
+        pct(m.rim),
+        pct(m.twin_mean),
+        pct(m.twin_center),
+        pct(m.twin_rim)
+    ));
+    if let Some(after) = &m.after {
+        s.push_str(&format!(
+            "<p>After the fix: {} at {}</p>\n",
+            after.verdict.key(),
+            pct(after.mean)
+        ));
+    }
+    if !m.findings.is_empty() {
+        s.push_str("<ul>\n");
+        for f in &m.findings {
+            s.push_str(&format!(
+                "<li><code>{}</code> at {} ({}): {}. <i>Fix:</i> {}.{}</li>\n",
+                escape(&f.rule),
+                escape(&f.node),
+                escape(&f.versions),
+                escape(&f.why),
+                escape(&f.fix),
+                f.twin
+                    .as_ref()
+                    .map(|t| format!(" The twin uses {}.", escape(t)))
+                    .unwrap_or_default()
+            ));
+        }
+        s.push_str("</ul>\n");
+    }
+    s.push_str("</div>\n");
+    s
+}

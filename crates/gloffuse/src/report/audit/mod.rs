@@ -1,0 +1,115 @@
+//! Renderers of the audit's verdict: `table` (terminal), `junit` (CI servers), `html` (a
+//! page for people, each material as authored beside its twin and their difference), and
+//! the report folder, whose pictures are made file by file while the audit streams.
+
+pub mod html;
+pub mod junit;
+pub mod table;
+
+use std::path::{Path, PathBuf};
+
+use super::deviation::colour;
+use super::png::{cell_image, encode_png};
+use crate::Error;
+use crate::audit::{AuditReport, FileDone};
+use crate::output::{self, write_output};
+use crate::verify::image::Rgba;
+
+/// The folder of material pictures, inside the report folder.
+const PICTURES: &str = "materials";
+
+/// The report folder while the audit runs: each file's pictures are written as it is done.
+pub struct ReportDir {
+    dir: PathBuf,
+    /// Per material, in report order: its picture's path relative to the folder, if rendered.
+    pictures: Vec<Option<String>>,
+}
+
+impl ReportDir {
+    /// Makes `dir` (its parent must exist) and its picture folder.
+    pub fn create(dir: &Path) -> Result<Self, Error> {
+        output::make_report_dir(dir)?;
+        let pictures = dir.join(PICTURES);
+        std::fs::create_dir_all(&pictures).map_err(|e| Error::Write {
+            path: pictures,
+            message: e.to_string(),
+        })?;
+        Ok(ReportDir {
+            dir: dir.to_path_buf(),
+            pictures: Vec::new(),
+        })
+    }
+
+    /// Writes one PNG per rendered material of `done`: as authored | twin | difference.
+    pub fn add(&mut self, done: &FileDone) -> Result<(), Error> {
+        for m in done.materials {
+            let picture = match (done.image, done.file.grid, m.cells) {
+                (Some(image), Some((columns, cell)), Some((own, twin))) => {
+                    let name = format!("{PICTURES}/{:05}.png", self.pictures.len());
+                    let rgb = strip(image, columns, cell, own, twin);
+                    let bytes =
+                        encode_png(&rgb, ((3 * cell) as u32, cell as u32)).map_err(|message| {
+                            Error::Write {
+                                path: self.dir.join(&name),
+                                message,
+                            }
+                        })?;
+                    write_output(&self.dir.join(&name), &bytes)?;
+                    Some(name)
+                }
+                _ => None,
+            };
+            self.pictures.push(picture);
+        }
+        Ok(())
+    }
+
+    /// Writes report.json and report.html; returns every path written at the top.
+    pub fn finish(self, report: &AuditReport, rerun: &str) -> Result<Vec<PathBuf>, Error> {
+        let json = self.dir.join("report.json");
+        let text = serde_json::to_string_pretty(report).expect("reports serialise to JSON");
+        write_output(&json, text.as_bytes())?;
+        let page = self.dir.join("report.html");
+        write_output(
+            &page,
+            html::render(report, &self.pictures, rerun).as_bytes(),
+        )?;
+        Ok(vec![json, page, self.dir.join(PICTURES)])
+    }
+}
+
+/// Three cells side by side, row by row: the material, its twin, and the relative
+/// difference (material − twin) / twin in false colour.
+fn strip(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize) -> Vec<u8> {
+    let a = cell_image(image, columns, cell, own);
+    let b = cell_image(image, columns, cell, twin);
+    let diff = difference(image, columns, cell, own, twin);
+    let mut rgb = Vec::with_capacity(a.len() * 3);
+    for y in 0..cell {
+        let row = y * cell * 3..(y + 1) * cell * 3;
+        rgb.extend_from_slice(&a[row.clone()]);
+        rgb.extend_from_slice(&b[row.clone()]);
+        rgb.extend_from_slice(&diff[row]);
+    }
+    rgb
+}
+
+fn difference(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize) -> Vec<u8> {
+    let origin = |i: usize| ((i % columns) * cell, (i / columns) * cell);
+    let ((ox, oy), (tx, ty)) = (origin(own), origin(twin));
+    let luminance = |p: [f32; 4]| f64::from(p[0] + p[1] + p[2]) / 3.0;
+    let mut rgb = Vec::with_capacity(cell * cell * 3);
+    for y in 0..cell {
+        for x in 0..cell {
+            let p = image.pixels[(oy + y) * image.width + ox + x];
+            let q = image.pixels[(ty + y) * image.width + tx + x];
+            let d = if p[3] < 0.5 || q[3] < 0.5 || luminance(q) <= 0.0 {
+                f64::NAN
+            } else {
+                luminance(p) / luminance(q) - 1.0
+            };
+            rgb.extend_from_slice(&colour(d));
+        }
+    }
+    rgb
+}

@@ -1,0 +1,95 @@
+//! The audit verdict for a terminal: one line per material (failures first), then its
+//! findings, the file findings, and the counts.
+
+use crate::audit::{AuditReport, AuditedMaterial, Verdict};
+
+fn pct(x: Option<f64>) -> String {
+    x.map_or_else(|| "—".to_string(), |x| format!("{:.1} %", 100.0 * x))
+}
+
+/// Failures first (creates, loses, error), then the rest, each in report order.
+pub fn order(report: &AuditReport) -> Vec<&AuditedMaterial> {
+    let mut ms: Vec<&AuditedMaterial> = report.materials.iter().collect();
+    ms.sort_by_key(|m| m.verdict);
+    ms
+}
+
+pub fn render(report: &AuditReport) -> String {
+    let mut s = format!(
+        "Audit of {} materials in {} files, Blender {} ({} px, {} spp)\n\n",
+        report.counts.materials,
+        report.counts.files,
+        report.blender_version,
+        report.settings.cell,
+        report.settings.samples
+    );
+    s.push_str(&format!(
+        "{:<8} {:>8} {:>8} {:>8}  {}\n",
+        "verdict", "mean", "rim", "twin", "material (file) — findings"
+    ));
+    for m in order(report) {
+        let rules: Vec<&str> = m.findings.iter().map(|f| f.rule.as_str()).collect();
+        s.push_str(&format!(
+            "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
+            m.verdict.key(),
+            pct(m.mean),
+            pct(m.rim),
+            pct(m.twin_mean),
+            m.material,
+            short(&m.file),
+            if rules.is_empty() {
+                String::new()
+            } else {
+                format!(" — {}", rules.join(", "))
+            }
+        ));
+        if m.verdict != Verdict::Ok {
+            s.push_str(&format!("{:<36}{}\n", "", m.reason));
+        }
+        if let Some(after) = &m.after {
+            s.push_str(&format!(
+                "{:<36}after the fix: {} at {}\n",
+                "",
+                after.verdict.key(),
+                pct(after.mean)
+            ));
+        }
+    }
+    for f in &report.files {
+        if let Some(e) = &f.error {
+            s.push_str(&format!("\nerror   {}: {e}\n", f.file));
+        }
+        for finding in &f.findings {
+            s.push_str(&format!(
+                "\n{}: {} — {}\n",
+                f.file, finding.rule, finding.why
+            ));
+        }
+        if let Some(fixed) = &f.fixed {
+            s.push_str(&format!(
+                "\nfixed   {} → {} ({} lobes replaced)\n",
+                f.file, fixed.path, fixed.replaced
+            ));
+        }
+    }
+    let c = &report.counts;
+    let failing: Vec<&str> = report.settings.fail_on.iter().map(|v| v.key()).collect();
+    s.push_str(&format!(
+        "\n{}: {} ok, {} lose energy, {} create energy, {} errors (failing on: {})\n",
+        if report.passed { "PASS" } else { "FAIL" },
+        c.ok,
+        c.loses,
+        c.creates,
+        c.error,
+        failing.join(", ")
+    ));
+    s
+}
+
+/// A file's name, for a table line.
+fn short(path: &str) -> &str {
+    std::path::Path::new(path)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or(path)
+}
