@@ -17,6 +17,8 @@ pub enum Job {
     Generate,
     /// Build the groups, render a furnace grid and write it as an EXR (`verify`, `refresh`).
     Furnace,
+    /// Scan a user's .blend for energy problems, render each material and its twin (`audit`).
+    Audit,
 }
 
 impl Job {
@@ -25,6 +27,7 @@ impl Job {
         match self {
             Job::Generate => "generate",
             Job::Furnace => "furnace_job",
+            Job::Audit => "audit_job",
         }
     }
 }
