@@ -334,27 +334,39 @@ def furnace_cycles_settings(cycles, scene, furnace):
     compat_disable_denoising(scene)
 
 
-def furnace_scene(furnace):
-    """Build the furnace grid in the current (empty) scene and return it."""
-    scene = bpy.context.scene
-    columns, rows = furnace_grid(furnace)
+def furnace_stage(scene, furnace, columns, rows):
+    """Make `scene` the furnace (white world, render settings, camera) for a
+    grid of `columns` x `rows` cells, without spheres."""
     scene.world = furnace_world()  # before the settings: EEVEE's are partly the world's
     furnace_render_settings(scene, furnace, columns, rows)
-
     camera = furnace_camera(columns)
     scene.collection.objects.link(camera)
     scene.camera = camera
 
+
+def furnace_place_materials(scene, furnace, materials, columns, rows):
+    """One sphere per material, in grid order (row-major, row 0 at the top),
+    linked to the scene's master collection and seen by camera rays only."""
     mesh = furnace_sphere_mesh(0.5 * furnace["radius_fraction"])
-    for index, sphere in enumerate(furnace["spheres"]):
+    for index, material in enumerate(materials):
         column, row = index % columns, index // columns
         obj = bpy.data.objects.new("Furnace sphere %03d" % index, mesh)
         obj.location = (column + 0.5 - 0.5 * columns, 0.5 * rows - row - 0.5, 0.0)
         scene.collection.objects.link(obj)
         slot = obj.material_slots[0]
         slot.link = "OBJECT"
-        slot.material = furnace_material(index, sphere, furnace["color"])
+        slot.material = material
         compat_camera_rays_only(obj)
+
+
+def furnace_scene(furnace):
+    """Build the furnace grid in the current (empty) scene and return it."""
+    scene = bpy.context.scene
+    columns, rows = furnace_grid(furnace)
+    furnace_stage(scene, furnace, columns, rows)
+    materials = [furnace_material(index, sphere, furnace["color"])
+                 for index, sphere in enumerate(furnace["spheres"])]
+    furnace_place_materials(scene, furnace, materials, columns, rows)
     return scene
 
 

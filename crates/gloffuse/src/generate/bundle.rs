@@ -31,6 +31,18 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/addon.py"),
     ),
     (
+        "audit_job",
+        include_str!("../../../../blender/gloffuse_blender/audit_job.py"),
+    ),
+    (
+        "audit_rules",
+        include_str!("../../../../blender/gloffuse_blender/audit_rules.py"),
+    ),
+    (
+        "audit_twin",
+        include_str!("../../../../blender/gloffuse_blender/audit_twin.py"),
+    ),
+    (
         "compat",
         include_str!("../../../../blender/gloffuse_blender/compat.py"),
     ),

@@ -1,0 +1,260 @@
+# ---------------------------------------------------------------------------
+# gloffuse audit_job.py: the main of `gloffuse audit`, one Blender run per
+# user's .blend file (the audit's shared interface, issue 21).
+#
+# The job module of the audit script: the gloffuse binary bundles it with the
+# modules it imports, after the header that defines GLOFFUSE_PARAMS, and ends
+# the script with main(GLOFFUSE_PARAMS). It opens the user's file (never
+# saving it), scans every material (audit_rules.py), optionally saves a fixed
+# copy (audit_twin.py's replacements on the real materials), then turns the
+# file's scene into the furnace (furnace.py) with each material and its
+# conserving twin on a sphere, renders once and prints one line
+#   GLOFFUSE_RESULT {json}
+# Rust reads the EXR back and judges. A material that cannot be audited gets
+# an error and the run goes on; a file that cannot be opened exits 1 (run_main).
+# ---------------------------------------------------------------------------
+import json
+import os
+import sys
+import time
+
+import bpy
+
+from .audit_rules import applicable_rules, scan_material, scan_scenes, twin_groups
+from .audit_twin import (
+    apply_finding,
+    datablock_pointers,
+    has_replacement,
+    make_twin,
+    remove_unused_added,
+    restore_groups,
+    set_aside_groups,
+)
+from .compat import blender_version_string, filter_glossy_property, material_node_tree
+from .furnace import furnace_place_materials, furnace_stage, render_sweep
+from .groups import build_all, group_names
+from .params import resolve_params
+from .runtime import result_line, run_main, save_blend
+
+# Cycles' path depth in the audit: deep enough that glass and layered
+# materials lose next to nothing to the bounce limit (the twins are judged
+# against 1.0), no volumes (a furnace of surfaces).
+AUDIT_BOUNCES = {"max_bounces": 12, "diffuse_bounces": 4, "glossy_bounces": 4,
+                 "transmission_bounces": 12, "transparent_max_bounces": 8, "volume_bounces": 0}
+
+
+class AuditParamsError(ValueError):
+    """The parameter document's "audit" section is missing or malformed."""
+
+
+def audit_require(cond, message):
+    if not cond:
+        raise AuditParamsError("audit parameters: " + message)
+
+
+def audit_params(document):
+    """The "audit" section, checked; numbers as the furnace wants them."""
+    audit_require(isinstance(document, dict), "the parameter document must be an object")
+    section = document.get("audit")
+    audit_require(isinstance(section, dict), "the document has no \"audit\" object")
+    audit_require(isinstance(section.get("file"), str) and section["file"], "\"file\" must be a path")
+    render = bool(section.get("render", True))
+    audit_require(not render or isinstance(section.get("output"), str), "\"output\" must be a path")
+    audit_require(isinstance(section.get("rules"), list), "\"rules\" must be a list")
+    for key in ("cell", "samples", "columns"):
+        audit_require(isinstance(section.get(key), int) and section[key] >= 1,
+                      "%r must be a positive integer" % key)
+    return dict(section, render=render, engine="cycles", seed=int(section.get("seed", 0)),
+                threads=int(section.get("threads", 0)),
+                radius_fraction=float(section.get("radius_fraction", 0.9)))
+
+
+# --- scanning ---------------------------------------------------------------------
+
+def scan_file(rules, groups):
+    """One entry per (non Grease Pencil) material: its result fields and, under
+    "_material", the datablock. A failing material gets an error, never the run."""
+    entries = []
+    for material in bpy.data.materials:
+        if material.is_grease_pencil:
+            continue
+        entry = {"name": material.name,
+                 "library": material.library.filepath if material.library else None,
+                 "users": material.users, "cell": None, "twin_cell": None, "replaced": 0,
+                 "findings": [], "error": None, "_material": material}
+        try:
+            entry["findings"], entry["error"] = scan_material(material, rules, groups)
+        except Exception as error:  # one material's problem is its own
+            entry["error"] = "scan failed: %s: %s" % (type(error).__name__, error)
+        entries.append(entry)
+    return entries
+
+
+def needs_groups(entries, groups):
+    names = set(groups["multiscatter"].values()) | set(groups["layered"].values())
+    return any(item["twin"] in names for entry in entries for item in entry["findings"])
+
+
+def build_twin_groups(document):
+    """Build the document's groups, the file's own of those names set aside
+    (build_all would rebuild them in place). Returns what restore needs."""
+    params = resolve_params(document)
+    before = datablock_pointers()
+    kept = set_aside_groups(group_names(params))
+    build_all(params)
+    return before, kept
+
+
+def fix_and_save(entries, document, audit, groups):
+    """Apply every replacement to the real materials (shared group trees in
+    place), drop what this run added and nothing uses, save the copy."""
+    built = build_twin_groups(document) if needs_groups(entries, groups) else None
+    replaced = materials = 0
+    for entry in entries:
+        tree = material_node_tree(entry["_material"])
+        if entry["error"] is not None or tree is None:
+            continue
+        count = sum(1 for item in entry["findings"] if apply_finding(tree, item))
+        replaced += count
+        materials += 1 if count else 0
+    if built is not None:
+        remove_unused_added(built[0])
+        restore_groups(built[1])
+    path = save_blend(audit["fix_output"], bool(audit.get("compress")))
+    return {"path": path, "replaced": replaced, "materials": materials}
+
+
+# --- the furnace -------------------------------------------------------------------
+
+def twins_and_cells(entries):
+    """Make each material's twin and give every renderable material (and twin)
+    its grid cell, in order; returns the materials to place."""
+    cells = []
+    for entry in entries:
+        if entry["error"] is not None:
+            continue
+        try:
+            twin, entry["replaced"] = make_twin(entry["_material"], entry["findings"])
+        except Exception as error:
+            entry["error"] = "twin failed: %s: %s" % (type(error).__name__, error)
+            continue
+        entry["cell"] = len(cells)
+        cells.append(entry["_material"])
+        if twin is not None:
+            cells.append(twin)
+        entry["twin_cell"] = len(cells) - 1
+    return cells
+
+
+def clear_scene(scene):
+    """Unlink every object and child collection from the scene (in memory only)."""
+    for obj in list(scene.collection.objects):
+        scene.collection.objects.unlink(obj)
+    for child in list(scene.collection.children):
+        scene.collection.children.unlink(child)
+
+
+def audit_render_settings(scene):
+    """What a user's scene may have changed that the furnace of verify never
+    meets: path depth, caustics, Filter Glossy, simplify, overrides, layers."""
+    cycles, render = scene.cycles, scene.render
+    setattr(cycles, filter_glossy_property(cycles), 0.0)
+    for key, value in AUDIT_BOUNCES.items():
+        setattr(cycles, key, value)
+    cycles.caustics_reflective = True
+    cycles.caustics_refractive = True
+    cycles.film_exposure = 1.0
+    cycles.use_fast_gi = False
+    cycles.pixel_filter_type = "BLACKMAN_HARRIS"
+    cycles.filter_width = 1.5
+    render.use_simplify = False
+    render.use_motion_blur = False
+    render.use_multiview = False
+    render.use_freestyle = False
+    render.use_single_layer = True
+    for layer in scene.view_layers:
+        layer.material_override = None
+        layer.samples = 0
+        layer.use = True
+        layer.use_solid = True
+
+
+def furnace_render(entries, audit):
+    """Twins, the furnace in the context scene, one render. Returns (scene, seconds)
+    or (None, 0.0) when no material can be rendered."""
+    cells = twins_and_cells(entries)
+    if not cells:
+        return None, 0.0
+    scene = bpy.context.scene
+    columns = audit["columns"]
+    rows = (len(cells) + columns - 1) // columns
+    clear_scene(scene)
+    furnace_stage(scene, audit, columns, rows)
+    audit_render_settings(scene)
+    furnace_place_materials(scene, audit, cells, columns, rows)
+    return scene, render_sweep(os.path.abspath(audit["output"]))
+
+
+# --- main ----------------------------------------------------------------------------
+
+def open_user_file(path):
+    """Open the user's file (never saved: the audit only reads it)."""
+    path = os.path.abspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError("no .blend file at %s" % path)
+    bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+    return path
+
+
+def audit_main(document_text):
+    document = json.loads(document_text)
+    audit = audit_params(document)
+    rules = applicable_rules(audit["rules"])
+    groups = twin_groups(document)
+    path = open_user_file(audit["file"])
+
+    start = time.perf_counter()
+    file_findings = scan_scenes(rules)
+    entries = scan_file(rules, groups)
+    scan_seconds = time.perf_counter() - start
+
+    fixed = None
+    if audit.get("fix_output"):
+        fixed = fix_and_save(entries, document, audit, groups)
+        if audit["render"]:
+            # The furnace shows the materials as authored: start again from the file.
+            open_user_file(path)
+            entries = [dict(fresh, findings=entry["findings"], error=entry["error"])
+                       for fresh, entry in zip(scan_file(rules, groups), entries)]
+
+    scene, seconds = None, 0.0
+    if audit["render"]:
+        if needs_groups(entries, groups):
+            build_twin_groups(document)
+        scene, seconds = furnace_render(entries, audit)
+    else:
+        for entry in entries:
+            entry["replaced"] = sum(1 for item in entry["findings"] if has_replacement(item))
+
+    result = {
+        "blender_version": blender_version_string(),
+        "file": path,
+        "output": os.path.abspath(audit["output"]) if scene is not None else None,
+        "width": scene.render.resolution_x if scene is not None else 0,
+        "height": scene.render.resolution_y if scene is not None else 0,
+        "columns": audit["columns"],
+        "scan_seconds": round(scan_seconds, 3),
+        "render_seconds": round(seconds, 3),
+        "file_findings": file_findings,
+        "materials": [{key: value for key, value in entry.items() if key != "_material"}
+                      for entry in entries],
+        "fixed": fixed,
+    }
+    print(result_line(result))
+    sys.stdout.flush()
+
+
+def main(document_text):
+    """The audit job on the parameter document `document_text` (JSON), with
+    run_main's error handling: traceback, and exit 1 headless."""
+    run_main(lambda: audit_main(document_text))

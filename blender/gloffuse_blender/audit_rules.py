@@ -1,0 +1,493 @@
+# ---------------------------------------------------------------------------
+# gloffuse audit_rules.py: the scan of `gloffuse audit`. It walks the nodes a
+# material really renders with (upstream of its active Cycles output, through
+# Reroutes and muted nodes, into node groups but never into gloffuse's own,
+# which are already corrected) and reports each energy problem or unusual
+# case as a finding: a plain dict {rule, node, node_type, detail, twin}
+# (the audit's shared interface, issue 21). Rust owns the catalogue text and
+# the version ranges; the document's "rules" list says which ids apply here.
+#
+# A module of the gloffuse_blender package, used by the audit job
+# (audit_job.py) and its twins (audit_twin.py). Functions and constants only;
+# every Blender version difference goes through compat.py.
+#
+#   applicable_rules(rules) -> set of rule ids that apply in this Blender
+#   twin_groups(document) -> the gloffuse group names a twin may use
+#   scan_material(material, rules, groups) -> ([finding, ...], error or None)
+#   scan_scenes(rules) -> file findings (filter-glossy)
+# ---------------------------------------------------------------------------
+import math
+import os
+
+import bpy
+
+from .compat import filter_glossy_property, is_missing, material_node_tree, principled_input, version_in_range
+from .nodes import is_tagged
+
+# Distributions whose single-scattering lobe loses energy, and what the twin
+# puts in place: Multiscatter GGX on the node itself, else a gloffuse group.
+SINGLE_SCATTER = ("GGX", "BECKMANN", "ASHIKHMIN_SHIRLEY")
+GLOSSY_TYPES = ("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
+MULTISCATTER_TWIN = "Multiscatter GGX"
+CLAMP_TWIN = "clamped to 1"
+TOON_TWIN = "Smooth 0"
+ADD_TWIN = "Mix Shader (Fac 0.5)"
+
+# Nodes that carry no reflecting closure (add-reflecting), and the colour
+# inputs that may exceed 1 (light, not albedo: color-above-one).
+NOT_REFLECTING = ("ShaderNodeEmission", "ShaderNodeHoldout", "ShaderNodeBackground",
+                  "ShaderNodeVolumeAbsorption", "ShaderNodeVolumeScatter",
+                  "ShaderNodeVolumePrincipled", "ShaderNodeVolumeInfo")
+REFLECTING_EXTRA = ("ShaderNodeSubsurfaceScattering", "ShaderNodeEeveeSpecular")
+LIGHT_NODES = NOT_REFLECTING
+KNOWN_OTHER_TYPES = ("NodeGroup", "NodeReroute", "NodeFrame", "NodeGroupInput",
+                     "NodeGroupOutput", "ShaderNodeGroup")
+OWN_GROUP_PREFIXES = ("Gloffuse ", "Brightness Correction")
+COLOR_EPSILON = 1e-6
+
+
+# --- version, document ---------------------------------------------------------
+
+def applicable_rules(rules):
+    """The ids of the document's rules whose [from, before) range holds this Blender."""
+    return {rule["id"] for rule in rules if version_in_range(rule["from"], rule.get("before"))}
+
+
+def twin_groups(document):
+    """{"multiscatter": {distribution: group name}, "layered": {...}} from the
+    generate part of the document (empty when it names no groups)."""
+    names = {"multiscatter": {}, "layered": {}}
+    for spec in document.get("groups") or []:
+        multiscatter = (spec.get("view") or {}).get("multiscatter_group")
+        if multiscatter:
+            names["multiscatter"][spec["distribution"]] = multiscatter
+        if spec.get("layered_group"):
+            names["layered"][spec["distribution"]] = spec["layered_group"]
+    return names
+
+
+def is_own_group(tree):
+    """A gloffuse group: already corrected, never scanned or flagged."""
+    return is_tagged(tree) or tree.name.startswith(OWN_GROUP_PREFIXES)
+
+
+# --- sockets and the walk ----------------------------------------------------------
+
+def source(socket):
+    """The output socket that feeds input `socket`, looking through Reroutes
+    and muted nodes (whose internal links pass a value on); None if unlinked."""
+    for _hop in range(1000):  # a bound, not a limit any real tree reaches
+        links = [link for link in socket.links if not link.is_muted and link.is_valid]
+        if not links:
+            return None
+        out = links[0].from_socket
+        node = out.node
+        if node.bl_idname == "NodeReroute":
+            socket = node.inputs[0]
+        elif node.mute:
+            passed = [link.from_socket for link in node.internal_links if link.to_socket == out]
+            if not passed:
+                return None
+            socket = passed[0]
+        else:
+            return out
+    return None
+
+
+def source_node(socket):
+    out = source(socket)
+    return None if out is None else out.node
+
+
+def constant(socket):
+    """The socket's own value when nothing feeds it (a float, or [r, g, b]), else None."""
+    if source(socket) is not None:
+        return None
+    value = socket.default_value
+    if socket.type == "RGBA":
+        return [round(float(c), 6) for c in value[:3]]
+    if socket.type == "VALUE":
+        return round(float(value), 6)
+    return None
+
+
+def active_output(tree, types=("ShaderNodeOutputMaterial",)):
+    """The output Cycles renders: the active one targeting All or Cycles, else any."""
+    outputs = [node for node in tree.nodes if node.bl_idname in types]
+    for node in outputs:
+        if getattr(node, "is_active_output", False) and getattr(node, "target", "ALL") in ("ALL", "CYCLES"):
+            return node
+    for node in outputs:
+        if getattr(node, "target", "ALL") in ("ALL", "CYCLES"):
+            return node
+    return outputs[0] if outputs else None
+
+
+def reachable(tree, starts, path, stack=()):
+    """(node, path) of every node upstream of the input sockets `starts`,
+    depth first, descending into groups (path: the names down to the node)."""
+    seen = set()
+    todo = list(reversed(starts))
+    while todo:
+        node = source_node(todo.pop())
+        if node is None or node.name in seen:
+            continue
+        seen.add(node.name)
+        node_path = path + [node.name]
+        yield node, node_path
+        todo.extend(reversed([sock for sock in node.inputs if sock.is_linked]))
+        group = getattr(node, "node_tree", None) if node.bl_idname == "ShaderNodeGroup" else None
+        if group is not None and not is_own_group(group) and group.name not in stack:
+            output = active_output(group, ("NodeGroupOutput",))
+            if output is not None:
+                yield from reachable(group, list(output.inputs), node_path, stack + (group.name,))
+
+
+def material_starts(tree):
+    output = active_output(tree)
+    return output, ([] if output is None else [output.inputs["Surface"], output.inputs["Volume"]])
+
+
+def resolve_path(tree, path):
+    """The node a finding's path addresses below the material, and the chain of
+    (group node, tree) it goes through; (None, chain) if it is gone."""
+    chain = []
+    for name in path[1:-1]:
+        node = tree.nodes.get(name)
+        if node is None or getattr(node, "node_tree", None) is None:
+            return None, chain
+        chain.append(node)
+        tree = node.node_tree
+    return tree.nodes.get(path[-1]), chain
+
+
+# --- findings --------------------------------------------------------------------
+
+def finding(rule, node, detail, twin=None):
+    return {"rule": rule, "node": None, "node_type": node.bl_idname if node is not None else "Material",
+            "detail": detail, "twin": twin}
+
+
+def rough(node, name="Roughness"):
+    """A roughness that matters: linked (None) or above 0."""
+    value = constant(node.inputs[name])
+    return value is None or value > 0.0, value
+
+
+def multiscatter_twin(distribution, groups):
+    if distribution == "GGX":
+        return MULTISCATTER_TWIN
+    return groups["multiscatter"].get(distribution)
+
+
+def glossy_detail(node, roughness):
+    detail = {"distribution": node.distribution, "roughness": roughness,
+              "color": constant(node.inputs["Color"])}
+    if "Anisotropy" in node.inputs:
+        detail["anisotropy"] = constant(node.inputs["Anisotropy"])
+    return detail
+
+
+def rule_glossy_single_scatter(node, groups):
+    if node.bl_idname not in GLOSSY_TYPES or node.distribution not in SINGLE_SCATTER:
+        return []
+    matters, roughness = rough(node)
+    if not matters:
+        return []
+    return [finding("glossy-single-scatter", node, glossy_detail(node, roughness),
+                    multiscatter_twin(node.distribution, groups))]
+
+
+def rule_anisotropic_multiscatter(node, groups):
+    if node.bl_idname not in GLOSSY_TYPES or node.distribution != "MULTI_GGX" \
+            or "Anisotropy" not in node.inputs:
+        return []
+    anisotropy = constant(node.inputs["Anisotropy"])
+    if anisotropy == 0.0:
+        return []
+    return [finding("anisotropic-multiscatter", node, glossy_detail(node, constant(node.inputs["Roughness"])))]
+
+
+def rule_microfacet_single_scatter(rule, idname, twin):
+    """The GGX/Beckmann rules of Metallic, Glass and Refraction BSDF."""
+    def rule_function(node, groups):
+        if node.bl_idname != idname or node.distribution not in ("GGX", "BECKMANN"):
+            return []
+        matters, roughness = rough(node)
+        if not matters:
+            return []
+        detail = {"distribution": node.distribution, "roughness": roughness}
+        if "IOR" in node.inputs:
+            detail["ior"] = constant(node.inputs["IOR"])
+        return [finding(rule, node, detail, twin)]
+    return rule_function
+
+
+def principled_detail(node):
+    return {"distribution": node.distribution, "roughness": constant(node.inputs["Roughness"]),
+            "ior": principled_ior(node), "color": constant(node.inputs["Base Color"])}
+
+
+def principled_ior(node):
+    """The dielectric IOR of the specular layer: 3.x's Specular s (F0 = 0.08 s,
+    eta = (1 + sqrt F0) / (1 - sqrt F0); linked: 1.5), 4.0+'s IOR input."""
+    specular = principled_input(node, "specular")
+    if specular is None:
+        return constant(node.inputs["IOR"])
+    s = constant(specular)
+    if s is None:
+        return 1.5
+    root = math.sqrt(min(max(0.08 * s, 0.0), 0.99))
+    return round((1.0 + root) / (1.0 - root), 6)
+
+
+def rule_principled_single_scatter(node, groups):
+    if node.bl_idname != "ShaderNodeBsdfPrincipled" or node.distribution != "GGX":
+        return []
+    return [finding("principled-single-scatter", node, principled_detail(node), MULTISCATTER_TWIN)]
+
+
+def principled_is_plain_dielectric(node):
+    """Metallic, Transmission and Subsurface all constant 0: the Principled BSDF
+    is a coat over a diffuse base, which the layered group models."""
+    sockets = [node.inputs["Metallic"], principled_input(node, "transmission"),
+               principled_input(node, "subsurface")]
+    return all(sock is None or constant(sock) == 0.0 for sock in sockets)
+
+
+def rule_principled_creates_energy(node, groups):
+    if node.bl_idname != "ShaderNodeBsdfPrincipled":
+        return []
+    twin = groups["layered"].get("GGX") if principled_is_plain_dielectric(node) else None
+    return [finding("principled-creates-energy", node, principled_detail(node), twin)]
+
+
+def layering_parts(mix):
+    """(factor node, diffuse, glossy) of a Mix Shader layering a Glossy over a
+    Diffuse by a Fresnel or Layer Weight factor; None for any other Mix."""
+    if mix.bl_idname != "ShaderNodeMixShader":
+        return None
+    factor = source_node(mix.inputs[0])
+    if factor is None or factor.bl_idname not in ("ShaderNodeFresnel", "ShaderNodeLayerWeight"):
+        return None
+    a, b = source_node(mix.inputs[1]), source_node(mix.inputs[2])
+    if a is None or b is None:
+        return None
+    if b.bl_idname == "ShaderNodeBsdfDiffuse":
+        a, b = b, a
+    if a.bl_idname != "ShaderNodeBsdfDiffuse" or b.bl_idname not in GLOSSY_TYPES:
+        return None
+    return factor, a, b
+
+
+def layering_ior(factor):
+    """The coat's IOR the factor stands for: Fresnel's IOR (None if linked),
+    Layer Weight's 1 / (1 - Blend) when constant, else 1.5."""
+    if factor.bl_idname == "ShaderNodeFresnel":
+        return constant(factor.inputs["IOR"])
+    blend = constant(factor.inputs["Blend"])
+    if blend is None:
+        return 1.5
+    return round(1.0 / max(1.0 - blend, 1e-5), 6)  # Cycles' own floor on 1 - Blend
+
+
+def layered_twin(distribution, groups):
+    layered = groups["layered"]
+    return layered.get(distribution) or layered.get("GGX")
+
+
+def rule_mix_fresnel_layering(node, groups):
+    parts = layering_parts(node)
+    if parts is None:
+        return []
+    factor, diffuse, glossy = parts
+    detail = {"distribution": glossy.distribution, "roughness": constant(glossy.inputs["Roughness"]),
+              "ior": layering_ior(factor), "color": constant(diffuse.inputs["Color"])}
+    return [finding("mix-fresnel-layering", node, detail, layered_twin(glossy.distribution, groups))]
+
+
+def carries_reflection(socket, stack=()):
+    """Whether the shader feeding `socket` holds a reflecting closure."""
+    node = source_node(socket)
+    if node is None or node.bl_idname in NOT_REFLECTING:
+        return False
+    if node.bl_idname in ("ShaderNodeMixShader", "ShaderNodeAddShader"):
+        return any(carries_reflection(sock, stack) for sock in node.inputs if sock.type == "SHADER")
+    if node.bl_idname == "ShaderNodeGroup":
+        tree = node.node_tree
+        if tree is None or tree.name in stack:
+            return False
+        output = active_output(tree, ("NodeGroupOutput",))
+        return output is not None and any(carries_reflection(sock, stack + (tree.name,))
+                                          for sock in output.inputs if sock.type == "SHADER")
+    return node.bl_idname.startswith("ShaderNodeBsdf") or node.bl_idname in REFLECTING_EXTRA
+
+
+def rule_add_reflecting(node, groups):
+    if node.bl_idname != "ShaderNodeAddShader":
+        return []
+    if not (carries_reflection(node.inputs[0]) and carries_reflection(node.inputs[1])):
+        return []
+    return [finding("add-reflecting", node, {}, ADD_TWIN)]
+
+
+def is_surface_shader(node):
+    """A BSDF-like node whose colours are albedos (not a light, not a mixer)."""
+    return node.bl_idname not in LIGHT_NODES and node.bl_idname not in (
+        "ShaderNodeMixShader", "ShaderNodeAddShader", "ShaderNodeGroup") \
+        and any(sock.type == "SHADER" for sock in node.outputs)
+
+
+def rule_color_above_one(node, groups):
+    if not is_surface_shader(node):
+        return []
+    found = []
+    for sock in node.inputs:
+        if sock.type != "RGBA" or not getattr(sock, "enabled", True) or sock.name.startswith("Emission"):
+            continue
+        color = constant(sock)
+        if color is not None and max(color) > 1.0 + COLOR_EPSILON:
+            found.append(finding("color-above-one", node, {"input": sock.identifier, "color": color},
+                                 CLAMP_TWIN))
+    return found
+
+
+def rule_toon_smooth(node, groups):
+    if node.bl_idname != "ShaderNodeBsdfToon":
+        return []
+    matters, smooth = rough(node, "Smooth")
+    return [finding("toon-smooth", node, {"value": smooth}, TOON_TWIN)] if matters else []
+
+
+def image_file_missing(image):
+    if image.packed_file is not None or image.source not in ("FILE", "SEQUENCE", "TILED"):
+        return None
+    path = os.path.normpath(bpy.path.abspath(image.filepath, library=image.library))
+    if image.source == "TILED":
+        candidates = [path.replace("<UDIM>", str(tile.number)) for tile in image.tiles] or [path]
+    else:
+        candidates = [path]
+    return None if any(os.path.isfile(p) for p in candidates) else path
+
+
+def rule_missing_texture(node, groups):
+    if node.bl_idname not in ("ShaderNodeTexImage", "ShaderNodeTexEnvironment") or node.image is None:
+        return []
+    path = image_file_missing(node.image)
+    if path is None:
+        return []
+    return [finding("missing-texture", node, {"image": node.image.name, "path": path})]
+
+
+def rule_linked_group(node, groups):
+    tree = getattr(node, "node_tree", None) if node.bl_idname == "ShaderNodeGroup" else None
+    if tree is None or tree.library is None:
+        return []
+    return [finding("linked-library", node, {"library": tree.library.filepath,
+                                             "missing": is_missing(tree.library)})]
+
+
+def rule_emission(node, groups):
+    if node.bl_idname == "ShaderNodeEmission":
+        return [finding("emission", node, {"color": constant(node.inputs["Color"]),
+                                           "value": constant(node.inputs["Strength"])})]
+    if node.bl_idname != "ShaderNodeBsdfPrincipled":
+        return []
+    strength = constant(node.inputs["Emission Strength"])
+    color = constant(principled_input(node, "emission_color"))
+    if (strength is None or strength > 0.0) and (color is None or max(color) > 0.0):
+        return [finding("emission", node, {"color": color, "value": strength})]
+    return []
+
+
+def rule_holdout(node, groups):
+    return [finding("holdout", node, {})] if node.bl_idname == "ShaderNodeHoldout" else []
+
+
+def rule_unknown_node(node, groups):
+    idname = node.bl_idname
+    no_tree = idname == "ShaderNodeGroup" and node.node_tree is None
+    custom = not idname.startswith("ShaderNode") and idname not in KNOWN_OTHER_TYPES
+    if idname == "ShaderNodeScript" or no_tree or custom:
+        return [finding("unknown-node", node, {})]
+    return []
+
+
+NODE_RULES = (
+    rule_glossy_single_scatter,
+    rule_anisotropic_multiscatter,
+    rule_microfacet_single_scatter("metallic-single-scatter", "ShaderNodeBsdfMetallic", MULTISCATTER_TWIN),
+    rule_microfacet_single_scatter("glass-single-scatter", "ShaderNodeBsdfGlass", MULTISCATTER_TWIN),
+    rule_microfacet_single_scatter("refraction-single-scatter", "ShaderNodeBsdfRefraction", None),
+    rule_principled_creates_energy,  # before single-scatter: its twin replaces the node
+    rule_principled_single_scatter,
+    rule_mix_fresnel_layering,
+    rule_add_reflecting,
+    rule_color_above_one,
+    rule_toon_smooth,
+    rule_missing_texture,
+    rule_linked_group,
+    rule_emission,
+    rule_holdout,
+    rule_unknown_node,
+)
+
+
+# --- materials and scenes ------------------------------------------------------------
+
+def material_level_findings(material, output):
+    """Findings on the material itself: linked from a library, a linked Volume."""
+    found = []
+    if material.library is not None:
+        found.append(finding("linked-library", None, {"library": material.library.filepath,
+                                                      "missing": is_missing(material.library)}))
+        found[-1]["node"] = [material.name]
+    if output is not None and source(output.inputs["Volume"]) is not None:
+        found.append(finding("volume", output, {}))
+        found[-1]["node"] = [material.name, output.name]
+    return found
+
+
+def material_errors(found):
+    """The material error the findings amount to (missing texture or library), or None."""
+    errors = []
+    for item in found:
+        detail = item["detail"]
+        if item["rule"] == "missing-texture":
+            errors.append("missing texture %s (%s)" % (detail["image"], detail["path"]))
+        elif item["rule"] == "linked-library" and detail["missing"]:
+            errors.append("missing library %s" % detail["library"])
+    return "; ".join(errors) or None
+
+
+def scan_material(material, rules, groups):
+    """The findings of the rules in `rules` (ids) on `material`, and its error
+    (None when it can be rendered and judged)."""
+    tree = material_node_tree(material)
+    output, starts = material_starts(tree) if tree is not None else (None, [])
+    found = material_level_findings(material, output)
+    if tree is not None:
+        for node, path in reachable(tree, starts, [material.name]):
+            for rule in NODE_RULES:
+                for item in rule(node, groups):
+                    item["node"] = path
+                    found.append(item)
+    if is_missing(material) and not any(item["rule"] == "linked-library" for item in found):
+        found.append(finding("linked-library", None, {"library": None, "missing": True}))
+        found[-1]["node"] = [material.name]
+    error = material_errors(found)
+    return [item for item in found if item["rule"] in rules], error
+
+
+def scan_scenes(rules):
+    """File findings: every scene with Filter Glossy on."""
+    if "filter-glossy" not in rules:
+        return []
+    found = []
+    for scene in bpy.data.scenes:
+        value = getattr(scene.cycles, filter_glossy_property(scene.cycles))
+        if value > 0.0:
+            item = {"rule": "filter-glossy", "node": ["scene", scene.name], "node_type": "Scene",
+                    "detail": {"value": round(float(value), 6)}, "twin": None}
+            found.append(item)
+    return found
