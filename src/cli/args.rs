@@ -11,6 +11,7 @@ use gloffuse::Field;
 use gloffuse::albedo::AlbedoOptions;
 use gloffuse::audit::{AuditJudging, AuditOptions, FixTarget, Verdict};
 use gloffuse::bench::BenchOptions;
+use gloffuse::bench::audit::AuditBenchOptions;
 use gloffuse::blender::{BlenderOptions, InstallerOutput};
 use gloffuse::fit::{FitOptions, Point, Target, Weighting};
 use gloffuse::generate::{ColorModel, GenerateOptions, Mode};
@@ -942,11 +943,28 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = BenchOptions::default().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub spp: u32,
 
+    /// Time `audit` instead: on generated libraries of these many materials (e.g.
+    /// 25,100,400), in one Blender process each, and its rules alone, beside one process
+    /// per material on the smallest library.
+    #[arg(long, value_name = "N,...", value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub audit: Vec<u64>,
+
     #[command(flatten)]
     pub blender: BlenderArgs,
 }
 
 impl BenchArgs {
+    pub fn audit_options(&self) -> AuditBenchOptions {
+        AuditBenchOptions {
+            sizes: self.audit.iter().map(|&n| n as usize).collect(),
+            render: RenderSettings {
+                samples: self.spp,
+                ..RenderSettings::default()
+            },
+            blender: self.blender.options(false),
+        }
+    }
+
     pub fn options(&self) -> BenchOptions {
         BenchOptions {
             roughness: self.roughness.clone(),

@@ -259,6 +259,11 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             emit(out, l.json, &written, text::lut)?;
             Ok(Outcome::Success)
         }
+        Command::Bench(b) if !b.audit.is_empty() => {
+            let r = gloffuse::bench::audit::bench_audit(&b.audit_options(), &terminal)?;
+            out.write_all(text::bench_audit(&r).as_bytes())?;
+            Ok(Outcome::Success)
+        }
         Command::Bench(b) => {
             let r = gloffuse::bench::bench(&b.options(), &terminal)?;
             writeln!(

@@ -356,3 +356,45 @@ pub fn shown(shown: &Shown) -> String {
     }
     s
 }
+
+/// The audit benchmark: materials per second per library size, one process per file beside
+/// one process per material.
+pub fn bench_audit(r: &gloffuse::bench::audit::AuditBenchResult) -> String {
+    let mut s = format!(
+        "audit in Blender {} ({} px, {} spp), wall time with Blender's start:\n\n\
+         {:>9}  {:>14}  {:>12}  {:>14}  {:>16}\n",
+        r.blender_version,
+        r.cell,
+        r.samples,
+        "materials",
+        "one process",
+        "materials/s",
+        "rules alone",
+        "scan per 1,000"
+    );
+    for t in &r.sizes {
+        s.push_str(&format!(
+            "{:>9}  {:>12.1} s  {:>12.2}  {:>12.1} s  {:>14.2} s\n",
+            t.materials,
+            t.seconds,
+            t.materials_per_second,
+            t.rules_seconds,
+            t.scan_seconds_per_1000
+        ));
+    }
+    let p = &r.per_material;
+    let best = r
+        .sizes
+        .iter()
+        .map(|t| t.materials_per_second)
+        .fold(f64::NAN, f64::max);
+    s.push_str(&format!(
+        "\none process per material ({} materials): {:.1} s, {:.2} materials/s \
+         (one process per file is {:.1}× faster at its best)\n",
+        p.materials,
+        p.seconds,
+        p.materials_per_second,
+        best / p.materials_per_second
+    ));
+    s
+}

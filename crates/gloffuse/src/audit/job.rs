@@ -7,12 +7,15 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 use super::rules::{RuleRange, ranges};
 use crate::Error;
 use crate::blender::{Blender, BlenderOptions, Run, RunOutput, run_script, runs};
-use crate::generate::{GenerateParams, Job, assemble};
+use crate::generate::{GenerateParams, Job, assemble, layered_group_name, multiscatter_group_name};
+use crate::measure::{Distribution, Engine};
 use crate::output::write_output;
 use crate::verify::RenderSettings;
 use crate::verify::render::last_sample;
@@ -32,6 +35,30 @@ struct AuditSection {
     fix_output: Option<String>,
     compress: bool,
     rules: Vec<RuleRange>,
+    /// The gloffuse groups a twin may use, by mode and Blender distribution enum; the job
+    /// asks for the ones it needs (`needs`) when the document holds no groups.
+    twin_names: TwinNames,
+}
+
+#[derive(Clone, Debug, Serialize)]
+struct TwinNames {
+    multiscatter: BTreeMap<&'static str, String>,
+    layered: BTreeMap<&'static str, String>,
+}
+
+impl TwinNames {
+    fn new() -> Self {
+        let by = |name: fn(Distribution) -> String| {
+            Distribution::ALL
+                .into_iter()
+                .map(|d| (d.blender_enum(), name(d)))
+                .collect()
+        };
+        TwinNames {
+            multiscatter: by(|d| multiscatter_group_name(Engine::Cycles, d)),
+            layered: by(layered_group_name),
+        }
+    }
 }
 
 /// The job's parameter document: the generate fields (the groups twins may need), flattened,
@@ -39,7 +66,7 @@ struct AuditSection {
 #[derive(Serialize)]
 struct AuditParams<'a> {
     #[serde(flatten)]
-    generate: &'a GenerateParams,
+    generate: Option<&'a GenerateParams>,
     audit: AuditSection,
 }
 
@@ -90,17 +117,25 @@ pub struct JobResult {
     #[serde(default)]
     pub render_seconds: Option<f64>,
     #[serde(default)]
+    pub scan_seconds: Option<f64>,
+    #[serde(default)]
     pub file_findings: Vec<JobFinding>,
     pub materials: Vec<JobMaterial>,
     #[serde(default)]
     pub fixed: Option<JobFixed>,
+    /// The gloffuse groups the twins need, as (mode, distribution enum), when the document
+    /// held none: the job then stopped after its scan.
+    #[serde(default)]
+    pub needs: Vec<(String, String)>,
 }
 
 /// What one job run needs besides the file.
+#[derive(Clone, Copy)]
 pub struct JobSettings<'a> {
     pub blender: &'a Blender,
     pub options: &'a BlenderOptions,
-    pub groups: &'a GenerateParams,
+    /// The twins' gloffuse groups, once a job has asked for them.
+    pub groups: Option<&'a GenerateParams>,
     pub render: Option<RenderSettings>,
     /// About how many materials the file holds (for the grid's shape).
     pub materials: usize,
@@ -145,6 +180,7 @@ pub fn run_job(
         fix_output: fix_output.map(|p| p.to_string_lossy().into_owned()),
         compress,
         rules: ranges(),
+        twin_names: TwinNames::new(),
     };
     let params = AuditParams {
         generate: s.groups,

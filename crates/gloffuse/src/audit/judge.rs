@@ -31,7 +31,7 @@ impl Grid<'_> {
             self.cell,
             self.radius_fraction,
         );
-        if !(s.coverage >= MIN_COVERAGE) || !s.mean.is_finite() {
+        if s.coverage.is_nan() || s.coverage < MIN_COVERAGE || !s.mean.is_finite() {
             return None;
         }
         let rings = s.rings.iter().map(|r| r.mean).filter(|m| m.is_finite());
@@ -130,11 +130,29 @@ fn verdict(
     }
     match measured {
         None => by_rules(findings, judging),
-        Some((None, _)) | Some((_, None)) => (
-            Verdict::Error,
-            "nothing rendered to measure (a holdout, or fully transparent)".to_string(),
-        ),
+        Some((None, _)) | Some((_, None)) => unmeasured(findings),
         Some((Some(own), Some(twin))) => by_furnace(findings, own, twin, judging),
+    }
+}
+
+/// A sphere the furnace could not measure: a holdout or a volume without a surface is what
+/// it is (not judged); anything else that renders nothing is an error.
+fn unmeasured(findings: &[Finding]) -> (Verdict, String) {
+    match findings
+        .iter()
+        .find(|f| f.rule == "holdout" || f.rule == "volume")
+    {
+        Some(f) => (
+            Verdict::Ok,
+            format!(
+                "not judged: {} at {} leaves no surface for the furnace to measure",
+                f.rule, f.node
+            ),
+        ),
+        None => (
+            Verdict::Error,
+            "the furnace rendered nothing to measure (the sphere is transparent)".to_string(),
+        ),
     }
 }
 

@@ -16,13 +16,14 @@ pub use verdict::{
     Fixed, Verdict,
 };
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use crate::blend_file::{MATERIAL, count_blocks};
 use crate::blender::{Blender, BlenderOptions};
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::Engine;
+use crate::measure::{Distribution, Engine};
 use crate::output::{check_destination, temp_beside};
 use crate::progress::Progress;
 use crate::user_blend::{UserBlend, read_header};
@@ -88,15 +89,27 @@ pub fn audit(
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
     check(o)?;
-    let files = files::blend_files(&o.paths)?;
+    files::blend_files(&o.paths)?;
     let blender = o.blender.find(progress)?;
-    let fix_targets = fix_targets(o, &files, &blender)?;
-    let groups = twin_groups(&blender)?;
+    audit_with(&blender, o, progress, on_file)
+}
+
+/// [`audit`] with a Blender already found.
+pub fn audit_with(
+    blender: &Blender,
+    o: &AuditOptions,
+    progress: &dyn Progress,
+    on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
+) -> Result<AuditReport, Error> {
+    check(o)?;
+    let files = files::blend_files(&o.paths)?;
+    let fix_targets = fix_targets(o, &files, blender)?;
+    let mut twins = TwinGroups::new(blender);
     let counts: Vec<usize> = files
         .iter()
         .map(|f| count_blocks(f, MATERIAL).unwrap_or(1))
         .collect();
-    let mut report = empty_report(o, &blender);
+    let mut report = empty_report(o, blender);
     let mut predictor = Predictor::new(blender.version);
     let total: usize = counts.iter().sum();
     progress.begin(
@@ -110,15 +123,15 @@ pub fn audit(
     let mut done = 0u64;
     for ((file, materials), fix) in files.iter().zip(&counts).zip(&fix_targets) {
         let settings = JobSettings {
-            blender: &blender,
+            blender,
             options: &o.blender,
-            groups: &groups,
+            groups: None,
             render: o.render.then_some(o.settings),
             materials: *materials,
             on_fraction: &|f: f64| progress.set(done + (f.min(1.0) * *materials as f64) as u64),
         };
         let (audited_file, mut materials_done, image) =
-            match audit_file(&settings, file, fix.as_ref(), o, &mut predictor) {
+            match audit_file(&settings, &mut twins, file, fix.as_ref(), o, &mut predictor) {
                 Err(e @ Error::Interrupted { .. }) => {
                     progress.end();
                     return Err(e);
@@ -127,7 +140,13 @@ pub fn audit(
                 Ok(ok) => ok,
             };
         if let Some(fixed) = &audited_file.fixed {
-            match after(&settings, Path::new(&fixed.path), o, &mut predictor) {
+            match after(
+                &settings,
+                &mut twins,
+                Path::new(&fixed.path),
+                o,
+                &mut predictor,
+            ) {
                 Err(e @ Error::Interrupted { .. }) => {
                     progress.end();
                     return Err(e);
@@ -264,25 +283,110 @@ fn relative_to_root(file: &Path, roots: &[PathBuf]) -> PathBuf {
         .unwrap_or_else(|| file.file_name().map(PathBuf::from).unwrap_or_default())
 }
 
-/// The groups a twin may use: gloffuse's multiscatter and layered groups for this Blender.
-fn twin_groups(blender: &Blender) -> Result<GenerateParams, Error> {
-    let (coefficients, source) =
-        Coefficients::load_or_preset(None, Engine::Cycles, blender.version)?;
-    GenerateParams::new(
-        Curves::Pinned {
-            coefficients: &coefficients,
-            name: &source,
+/// The gloffuse groups twins use, built on a job's first request and grown to cover every
+/// later one: their tables take seconds to compute, so an audit whose materials need none
+/// never computes them, and one that does computes only the distributions and modes asked.
+struct TwinGroups<'a> {
+    blender: &'a Blender,
+    needs: BTreeSet<(Mode, Distribution)>,
+    params: Option<GenerateParams>,
+}
+
+impl<'a> TwinGroups<'a> {
+    fn new(blender: &'a Blender) -> Self {
+        TwinGroups {
+            blender,
+            needs: BTreeSet::new(),
+            params: None,
+        }
+    }
+
+    /// Groups covering `needs` (the job's (mode, distribution enum) pairs) and every earlier need.
+    fn cover(&mut self, needs: &[(String, String)], log: &Path) -> Result<&GenerateParams, Error> {
+        let mut grew = self.params.is_none();
+        for (mode, distribution) in needs {
+            let need = Mode::ALL
+                .into_iter()
+                .find(|m| m.key() == mode)
+                .zip(distribution.parse::<Distribution>().ok())
+                .filter(|(m, _)| matches!(m, Mode::Multiscatter | Mode::Layered))
+                .ok_or_else(|| Error::Blender {
+                    message: format!("the audit job asked for groups gloffuse does not build ({mode}, {distribution})").into(),
+                    log: Some(log.to_path_buf()),
+                    command: None,
+                })?;
+            grew |= self.needs.insert(need);
+        }
+        if grew {
+            let (mut coefficients, source) =
+                Coefficients::load_or_preset(None, Engine::Cycles, self.blender.version)?;
+            coefficients
+                .distributions
+                .retain(|d, _| self.needs.iter().any(|(_, n)| n == d));
+            let modes: Vec<Mode> = Mode::ALL
+                .into_iter()
+                .filter(|m| self.needs.iter().any(|(n, _)| n == m))
+                .collect();
+            self.params = Some(GenerateParams::new(
+                Curves::Pinned {
+                    coefficients: &coefficients,
+                    name: &source,
+                },
+                &[self.blender.version.masking()],
+                &modes,
+                ColorModel::Exact,
+            )?);
+        }
+        Ok(self.params.as_ref().expect("built above"))
+    }
+}
+
+/// Runs the job on `file`, and again with the gloffuse groups its twins asked for.
+fn run_twinned(
+    s: &JobSettings,
+    twins: &mut TwinGroups,
+    file: &Path,
+    fix_output: Option<&Path>,
+    compress: bool,
+) -> Result<JobRun, Error> {
+    let first = run_job(
+        &JobSettings {
+            groups: twins.params.as_ref(),
+            ..*s
         },
-        &[blender.version.masking()],
-        &[Mode::Multiscatter, Mode::Layered],
-        ColorModel::Exact,
-    )
+        file,
+        fix_output,
+        compress,
+    )?;
+    if first.result.needs.is_empty() {
+        return Ok(first);
+    }
+    let groups = twins.cover(&first.result.needs, &first.log)?;
+    let second = run_job(
+        &JobSettings {
+            groups: Some(groups),
+            ..*s
+        },
+        file,
+        fix_output,
+        compress,
+    )?;
+    if second.result.needs.is_empty() {
+        Ok(second)
+    } else {
+        Err(Error::Blender {
+            message: "the audit job asked again for the groups it was given".into(),
+            log: Some(second.log),
+            command: None,
+        })
+    }
 }
 
 type FileAudit = (AuditedFile, Vec<AuditedMaterial>, Option<Rgba>);
 
 fn audit_file(
     s: &JobSettings,
+    twins: &mut TwinGroups,
     file: &Path,
     fix: Option<&FixPlan>,
     o: &AuditOptions,
@@ -308,7 +412,7 @@ fn audit_file(
         }
     };
     let compress = fix.is_some_and(|f| f.input.compressed());
-    let job = run_job(s, &real, temp.as_deref(), compress)?;
+    let job = run_twinned(s, twins, &real, temp.as_deref(), compress)?;
     let image = job.exr.as_deref().map(read_grid).transpose()?;
     let (file_entry, materials) = judged(file, &job, image.as_ref(), o, predictor);
     let mut file_entry = file_entry;
@@ -365,6 +469,7 @@ fn judged(
         materials: job.result.materials.len(),
         log: Some(job.log.display().to_string()),
         render_seconds: job.result.render_seconds,
+        scan_seconds: job.result.scan_seconds,
         grid: image.map(|_| (columns, cell)),
         fixed: None,
     };
@@ -406,11 +511,12 @@ fn install_fix(
 /// The fixed file audited again.
 fn after(
     s: &JobSettings,
+    twins: &mut TwinGroups,
     fixed: &Path,
     o: &AuditOptions,
     predictor: &mut Predictor,
 ) -> Result<Vec<AuditedMaterial>, Error> {
-    let job = run_job(s, fixed, None, false)?;
+    let job = run_twinned(s, twins, fixed, None, false)?;
     let image = job.exr.as_deref().map(read_grid).transpose()?;
     Ok(judged(fixed, &job, image.as_ref(), o, predictor).1)
 }
@@ -440,6 +546,7 @@ fn failed_file(file: &Path, e: &Error) -> AuditedFile {
         materials: 0,
         log: None,
         render_seconds: None,
+        scan_seconds: None,
         grid: None,
         fixed: None,
     }

@@ -184,10 +184,11 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         id: "holdout",
-        effect: Effect::Error,
+        effect: Effect::Info,
         from: v(3, 0),
         before: None,
-        why: "a Holdout cuts the material out of the image, so there is nothing to measure",
+        why: "a Holdout cuts the material out of the image: where it covers the sphere there is \
+              nothing to measure",
         fix: "nothing, if the holdout is meant",
     },
     Rule {

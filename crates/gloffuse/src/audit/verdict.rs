@@ -143,6 +143,8 @@ pub struct AuditedFile {
     pub materials: usize,
     pub log: Option<String>,
     pub render_seconds: Option<f64>,
+    /// How long the rules took in Blender.
+    pub scan_seconds: Option<f64>,
     /// The rendered grid's columns and cell size, for pictures.
     #[serde(skip)]
     pub grid: Option<(usize, usize)>,

@@ -43,6 +43,10 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/audit_twin.py"),
     ),
     (
+        "bench_library",
+        include_str!("../../../../blender/gloffuse_blender/bench_library.py"),
+    ),
+    (
         "compat",
         include_str!("../../../../blender/gloffuse_blender/compat.py"),
     ),

@@ -11,7 +11,8 @@ pub mod params;
 pub mod script;
 
 pub use params::{
-    ColorModel, Curves, GenerateParams, GroupSpec, Mode, correction_group_name, shader_group_name,
+    ColorModel, Curves, GenerateParams, GroupSpec, Mode, correction_group_name, layered_group_name,
+    multiscatter_group_name, shader_group_name,
 };
 pub use script::{Job, assemble, assemble_with_main};
 

@@ -13,7 +13,7 @@ use crate::measure::{
 use crate::progress::Quiet;
 
 /// Which correction a shader group applies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Mode {
     /// Gain 100/f(r): the sphere's mean is 100 %, its centre darker, its rim brighter.
@@ -306,6 +306,15 @@ pub fn layered_group_name(d: Distribution) -> String {
     format!("Gloffuse Layered ({})", d.label())
 }
 
+/// `Gloffuse Multiscatter (GGX)`: the public name of the Glossy + lost-energy group.
+pub fn multiscatter_group_name(engine: Engine, d: Distribution) -> String {
+    format!(
+        "Gloffuse{} Multiscatter ({})",
+        engine_infix(engine),
+        d.label()
+    )
+}
+
 /// `Gloffuse (GGX)` (EEVEE: `Gloffuse EEVEE (GGX)`): the public name of the corrected
 /// shader group.
 pub fn shader_group_name(engine: Engine, d: Distribution) -> String {
@@ -422,7 +431,7 @@ fn group_spec(
             shader_group: wants(Mode::View)
                 .then(|| format!("Gloffuse{infix} View ({})", d.label())),
             multiscatter_group: wants(Mode::Multiscatter)
-                .then(|| format!("Gloffuse{infix} Multiscatter ({})", d.label())),
+                .then(|| multiscatter_group_name(engine, d)),
         }),
         families: loaded
             .iter()

@@ -19,6 +19,8 @@ pub enum Job {
     Furnace,
     /// Audit the materials of a user's .blend: rules, furnace and twins, and a fixed copy.
     Audit,
+    /// Save a .blend of varied materials for the audit benchmark (`bench --audit`).
+    BenchLibrary,
 }
 
 impl Job {
@@ -28,6 +30,7 @@ impl Job {
             Job::Generate => "generate",
             Job::Furnace => "furnace_job",
             Job::Audit => "audit_job",
+            Job::BenchLibrary => "bench_library",
         }
     }
 }

@@ -46,7 +46,7 @@ pub fn render(report: &AuditReport) -> String {
         if m.verdict != Verdict::Ok {
             s.push_str(&format!("{:<36}{}\n", "", m.reason));
         }
-        if let Some(after) = &m.after {
+        if let Some(after) = m.after.as_ref().filter(|_| m.replaced > 0) {
             s.push_str(&format!(
                 "{:<36}after the fix: {} at {}\n",
                 "",

@@ -1,6 +1,8 @@
 //! `gloffuse bench`: the verify sweep rendered as one Blender process against one process
 //! per sphere, the measurement behind "one Blender process renders a whole sweep".
 
+pub mod audit;
+
 use serde::Serialize;
 use std::time::Instant;
 
