@@ -111,9 +111,10 @@ def fix_and_save(entries, document, audit, groups):
     built = build_twin_groups(document) if needs_groups(entries, groups) else None
     replaced = materials = 0
     for entry in entries:
-        tree = material_node_tree(entry["_material"])
-        if entry["error"] is not None or tree is None:
-            continue
+        material = entry["_material"]
+        tree = material_node_tree(material)
+        if entry["error"] is not None or tree is None or material.library is not None:
+            continue  # a linked material is its library's to fix
         count = sum(1 for item in entry["findings"] if apply_finding(tree, item))
         replaced += count
         materials += 1 if count else 0
@@ -147,7 +148,9 @@ def twins_and_cells(entries):
 
 
 def clear_scene(scene):
-    """Unlink every object and child collection from the scene (in memory only)."""
+    """Unlink every object and child collection from the scene, and its
+    background set (in memory only)."""
+    scene.background_set = None
     for obj in list(scene.collection.objects):
         scene.collection.objects.unlink(obj)
     for child in list(scene.collection.children):

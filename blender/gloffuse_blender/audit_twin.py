@@ -159,12 +159,15 @@ def has_replacement(item):
 def tree_along(tree, path, copies):
     """The tree holding the node at `path` (material name first, node name last).
     With `copies` ({original tree name: copy}), each group on the way gets its
-    own copy, once per tree; without, the real trees (edited in place)."""
+    own copy, once per tree; without, the real trees (edited in place), and
+    None past a linked one."""
     for name in path[1:-1]:
         group_node = tree.nodes.get(name)
         if group_node is None or getattr(group_node, "node_tree", None) is None:
             return None
         sub = group_node.node_tree
+        if copies is None and sub.library is not None:
+            return None  # a linked group is read-only here: its library must be fixed
         if copies is not None and sub not in copies.values():
             if sub.name not in copies:
                 copies[sub.name] = sub.copy()

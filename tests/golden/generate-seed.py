@@ -14,6 +14,8 @@ GLOFFUSE_PARAMS = "{\"gloffuse_version\":\"0.1.0\",\"height_correlated_from\":[3
 # Functions and constants only. Every Blender version check of the package
 # (bpy.app.version, or a feature test standing for one) is here.
 # ---------------------------------------------------------------------------
+import os
+
 import bpy
 import bmesh  # after bpy: under the bpy module, bmesh exists only once bpy is imported
 
@@ -377,6 +379,58 @@ def compat_eevee_furnace(scene, world, samples):
         eevee.use_ssr = False
         eevee.use_gtao = False
         eevee.use_bloom = False
+
+
+# --- audit (audit_rules.py, audit_twin.py, audit_job.py) ---------------------------
+
+def version_in_range(first, before):
+    """Whether this Blender is at least `first` ([major, minor]) and below
+    `before` (or `before` is None): a rule's range in the audit document."""
+    version = tuple(bpy.app.version[:2])
+    return version >= tuple(first) and (before is None or version < tuple(before))
+
+
+def filter_glossy_property(cycles):
+    """The name of Cycles' Filter Glossy setting: `blur_glossy` (3.x to 5.0 at
+    least), `filter_glossy` where a newer Cycles renames it."""
+    return "filter_glossy" if hasattr(cycles, "filter_glossy") else "blur_glossy"
+
+
+# Principled BSDF inputs renamed in 4.0, newest name first.
+_PRINCIPLED_INPUTS = {
+    "transmission": ("Transmission Weight", "Transmission"),
+    "subsurface": ("Subsurface Weight", "Subsurface"),
+    "emission_color": ("Emission Color", "Emission"),
+    "specular": ("Specular",),  # 3.x only: F0 = 0.08 x Specular (4.0+ takes IOR)
+}
+
+
+def principled_input(node, role):
+    """The Principled BSDF input playing `role` (a key of _PRINCIPLED_INPUTS)
+    in this Blender, or None where it has no such input."""
+    for name in _PRINCIPLED_INPUTS[role]:
+        sock = node.inputs.get(name)
+        if sock is not None:
+            return sock
+    return None
+
+
+def is_missing(id_block):
+    """A linked datablock or library whose file was not found on load. ID.is_missing
+    exists from 4.x; before it, a library is missing when its file does not exist."""
+    if hasattr(id_block, "is_missing"):
+        return bool(id_block.is_missing)
+    if isinstance(id_block, bpy.types.Library):
+        return not os.path.isfile(bpy.path.abspath(id_block.filepath))
+    return False
+
+
+def material_node_tree(material):
+    """The node tree a material renders with, or None (no nodes: before 5.0
+    a material can have use_nodes off, and then renders its plain colour)."""
+    if not getattr(material, "use_nodes", True):
+        return None
+    return material.node_tree
 
 # ======== gloffuse part: nodes.py ========
 # ---------------------------------------------------------------------------
@@ -2001,7 +2055,6 @@ def sphere_mesh(name, radius, segments, rings, cut_below=None):
 #       ends the process when main is done (see end_process)
 # ---------------------------------------------------------------------------
 import argparse
-import os
 import shutil
 import sys
 import traceback
