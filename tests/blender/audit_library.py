@@ -14,6 +14,8 @@ It writes into DIR:
                               unreachable Glossy GGX that must not be flagged
   unusual.blend               a missing texture, Emission, Holdout, a volume, an OSL Script
                               node, a clean Diffuse, and a scene with Filter Glossy 1.0
+  linked.blend                a local material, one linked from //rules.blend, and one linked
+                              from //gone.blend, a library deleted once linked
   corrected.blend             (with --gloffuse-library) materials that already conserve energy:
                               gloffuse's "Gloffuse View (GGX)" group, Blender's Multiscatter GGX
   expected.json               what the audit should find in THIS Blender: per file, per material,
@@ -59,6 +61,7 @@ class Library:
 
     def __init__(self):
         bpy.ops.wm.read_factory_settings(use_empty=True)
+        bpy.context.preferences.filepaths.save_version = 0  # no FILE.blend1 beside a re-saved file
         mesh = bpy.data.meshes.new("Swatches")
         corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
         faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
@@ -85,7 +88,7 @@ class Library:
         output.target = "ALL"
         output.is_active_output = True
         self.mesh.materials.append(material)
-        self.materials[name] = {"verdict": verdict, "reason": reason, "findings": []}
+        self.materials[name] = {"verdict": verdict, "reason": reason, "findings": [], "library": None}
         return material, nodes, output
 
     def expect(self, material, rule, *path):
@@ -562,6 +565,47 @@ def corrected_file(path, gloffuse_library):
     return lib.save(path)
 
 
+# --- linked.blend ---------------------------------------------------------------------------
+
+LINKED = "glossy-multi-ggx-r1"
+GONE = "gone-glossy"
+
+
+def gone_file(path):
+    """gone.blend: a library that linked.blend links and that is then deleted."""
+    lib = Library()
+    m, n, out = lib.material(GONE, "error", "")
+    surface(m, out, glossy(n, "Glossy BSDF", "MULTI_GGX", 0.5).outputs[0])
+    lib.save(path)
+
+
+def linked_file(path, rules, gone):
+    """A local material, one linked from rules.blend (//rules.blend) and one linked from a
+    library that no longer exists (//gone.blend, deleted after linking)."""
+    lib = Library()
+    m, n, out = lib.material("local-diffuse", "ok", "a local white Diffuse: 100 %")
+    surface(m, out, diffuse(n).outputs[0])
+    bpy.ops.wm.save_as_mainfile(filepath=path, relative_remap=False)  # relative links need a path
+    for library, name in ((rules, LINKED), (gone, GONE)):
+        with bpy.data.libraries.load(library, link=True, relative=True) as (data_from, data_to):
+            data_to.materials = [name]
+        lib.mesh.materials.append(bpy.data.materials[name, bpy.data.libraries[os.path.basename(library)].filepath])
+    # The finding's node path is the material alone (the material itself is linked). Blender
+    # 4.x/5.0 mark the missing library and its placeholder material `is_missing`; 3.4 has no
+    # `is_missing` (the placeholder has no node tree, and the library's file does not exist).
+    lib.materials[LINKED] = {"verdict": "ok", "findings": [{"rule": "linked-library", "node": [LINKED]}],
+                             "library": "//rules.blend",
+                             "reason": "linked from //rules.blend (Multiscatter GGX r=1, 100 %): the "
+                                       "audit reports the link, the material conserves energy"}
+    lib.materials[GONE] = {"verdict": "error", "findings": [{"rule": "linked-library", "node": [GONE]}],
+                           "library": "//gone.blend",
+                           "reason": "linked from //gone.blend, which no longer exists: the material "
+                                     "cannot be audited"}
+    result = lib.save(path)
+    os.remove(gone)
+    return result
+
+
 # --- main -----------------------------------------------------------------------------------
 
 def main():
@@ -574,6 +618,10 @@ def main():
             "nested/deeper/nested.blend": nested_file(os.path.join(out, "nested", "deeper", "nested.blend")),
             "unusual.blend": unusual_file(os.path.join(out, "unusual.blend")),
         }
+        gone = os.path.join(out, "gone.blend")
+        gone_file(gone)
+        files["linked.blend"] = linked_file(os.path.join(out, "linked.blend"),
+                                            os.path.join(out, "rules.blend"), gone)
         if options.gloffuse_library:
             files["corrected.blend"] = corrected_file(os.path.join(out, "corrected.blend"),
                                                       os.path.abspath(options.gloffuse_library))
