@@ -1,8 +1,10 @@
 //! Helpers shared by the integration tests, one module per job: independent oracles
-//! (`oracle`), real Blenders (`blender`), a user's own .blend (`user_file`), and the binary
-//! itself ([`gloffuse`]).
+//! (`oracle`), real Blenders (`blender`), a user's own .blend (`user_file`), the audit's
+//! library of user materials and its expectations (`audit_library`), and the binary itself
+//! ([`gloffuse`]).
 #![allow(dead_code)]
 
+pub mod audit_library;
 pub mod blender;
 pub mod oracle;
 pub mod user_file;
