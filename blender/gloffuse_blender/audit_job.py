@@ -90,9 +90,24 @@ def scan_file(rules, groups):
     return entries
 
 
-def needs_groups(entries, groups):
-    names = set(groups["multiscatter"].values()) | set(groups["layered"].values())
-    return any(item["twin"] in names for entry in entries for item in entry["findings"])
+def group_needs(entries, groups):
+    """The (mode, distribution) of every gloffuse group a twin uses, sorted."""
+    by_name = {name: (mode, distribution) for mode, names in groups.items()
+               for distribution, name in names.items()}
+    return sorted({by_name[item["twin"]] for entry in entries for item in entry["findings"]
+                   if item["twin"] in by_name})
+
+
+def provided_groups(document):
+    """The (mode, distribution) of every twin group the document's generate
+    part builds."""
+    provided = set()
+    for spec in document.get("groups") or []:
+        if (spec.get("view") or {}).get("multiscatter_group"):
+            provided.add(("multiscatter", spec["distribution"]))
+        if spec.get("layered_group"):
+            provided.add(("layered", spec["distribution"]))
+    return provided
 
 
 def build_twin_groups(document):
@@ -108,7 +123,7 @@ def build_twin_groups(document):
 def fix_and_save(entries, document, audit, groups):
     """Apply every replacement to the real materials (shared group trees in
     place), drop what this run added and nothing uses, save the copy."""
-    built = build_twin_groups(document) if needs_groups(entries, groups) else None
+    built = build_twin_groups(document) if group_needs(entries, groups) else None
     replaced = materials = 0
     for entry in entries:
         material = entry["_material"]
@@ -213,13 +228,23 @@ def audit_main(document_text):
     document = json.loads(document_text)
     audit = audit_params(document)
     rules = applicable_rules(audit["rules"])
-    groups = twin_groups(document)
+    groups = twin_groups(audit)
     path = open_user_file(audit["file"])
 
     start = time.perf_counter()
     file_findings = scan_scenes(rules)
     entries = scan_file(rules, groups)
     scan_seconds = time.perf_counter() - start
+
+    needs = group_needs(entries, groups) if audit["render"] or audit.get("fix_output") else []
+    missing = [need for need in needs if need not in provided_groups(document)]
+    if missing:
+        # The groups' tables take gloffuse seconds to compute: it sends them only
+        # to a job that asks, and runs it again.
+        print(result_line({"blender_version": blender_version_string(), "file": path,
+                           "materials": [], "needs": missing, "scan_seconds": scan_seconds}))
+        sys.stdout.flush()
+        return
 
     fixed = None
     if audit.get("fix_output"):
@@ -232,7 +257,7 @@ def audit_main(document_text):
 
     scene, seconds = None, 0.0
     if audit["render"]:
-        if needs_groups(entries, groups):
+        if needs:
             build_twin_groups(document)
         scene, seconds = furnace_render(entries, audit)
     else:

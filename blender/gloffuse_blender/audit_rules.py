@@ -12,7 +12,7 @@
 # every Blender version difference goes through compat.py.
 #
 #   applicable_rules(rules) -> set of rule ids that apply in this Blender
-#   twin_groups(document) -> the gloffuse group names a twin may use
+#   twin_groups(audit) -> the gloffuse group names a twin may use
 #   scan_material(material, rules, groups) -> ([finding, ...], error or None)
 #   scan_scenes(rules) -> file findings (filter-glossy)
 # ---------------------------------------------------------------------------
@@ -53,17 +53,12 @@ def applicable_rules(rules):
     return {rule["id"] for rule in rules if version_in_range(rule["from"], rule.get("before"))}
 
 
-def twin_groups(document):
-    """{"multiscatter": {distribution: group name}, "layered": {...}} from the
-    generate part of the document (empty when it names no groups)."""
-    names = {"multiscatter": {}, "layered": {}}
-    for spec in document.get("groups") or []:
-        multiscatter = (spec.get("view") or {}).get("multiscatter_group")
-        if multiscatter:
-            names["multiscatter"][spec["distribution"]] = multiscatter
-        if spec.get("layered_group"):
-            names["layered"][spec["distribution"]] = spec["layered_group"]
-    return names
+def twin_groups(audit):
+    """{"multiscatter": {distribution: group name}, "layered": {...}}: the
+    gloffuse groups a twin may use, as the audit section names them (built only
+    when a job asks for them, see audit_job.py's group_needs)."""
+    names = audit.get("twin_names") or {}
+    return {mode: dict(names.get(mode) or {}) for mode in ("multiscatter", "layered")}
 
 
 def is_own_group(tree):

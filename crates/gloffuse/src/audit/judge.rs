@@ -14,6 +14,9 @@ const NOISE_SIGMAS: f64 = 3.0;
 /// fully transparent material).
 const MIN_COVERAGE: f64 = 0.5;
 
+/// A mean below this, with a node the audit does not know, is that node failing to render.
+const BLACK: f64 = 0.01;
+
 /// The rendered grid of one file.
 pub struct Grid<'a> {
     pub image: &'a Rgba,
@@ -200,6 +203,18 @@ fn by_furnace(
                 "renders at {}; its conserving twin at {}",
                 pct(own.mean),
                 pct(twin.mean)
+            ),
+        );
+    }
+    if own.mean < BLACK
+        && let Some(f) = findings.iter().find(|f| f.rule == "unknown-node")
+    {
+        return (
+            Verdict::Error,
+            format!(
+                "renders black: {} at {} did not render in this Blender (an OSL script needs \
+                 Cycles' Open Shading Language, which a headless Blender cannot compile)",
+                f.rule, f.node
             ),
         );
     }

@@ -59,7 +59,9 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "anisotropic-multiscatter",
         effect: Effect::Loses,
-        from: v(3, 0),
+        // 3.x's Multiscatter GGX is a random walk between microfacets, which conserves an
+        // anisotropic lobe too; 4.0 replaced it by the albedo-scaled single scatter.
+        from: v(4, 0),
         before: None,
         why: "Cycles compensates an anisotropic Multiscatter GGX lobe with the isotropic table \
               at the geometric-mean roughness, which misses most of its loss (73 % at \
