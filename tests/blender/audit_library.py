@@ -222,8 +222,8 @@ def rules_file(path):
 
     # Multiscatter GGX with anisotropy: 3.x's Multiscatter GGX is a random walk that handles
     # anisotropy (no rule); from 4.0 Cycles compensates it with the isotropic albedo table
-    # (the rule fires). 4.5 and 5.0 render it at 0.905 (r=0.5, anisotropy 0.5): it loses, but
-    # its twin is null (twin_cell == cell), so by the contract's verdict it is ok.
+    # (the rule fires). 4.5 and 5.0 render it at 0.905 (r=0.5, anisotropy 0.5): it loses, and
+    # with no conserving twin to compare against, a losing rule alone makes the verdict loses.
     name = "anisotropic-multi-ggx-a05"
     if pre4:
         m, n, out = lib.material(name, "ok", "3.x's random-walk Multiscatter GGX conserves energy "
@@ -231,9 +231,9 @@ def rules_file(path):
         surface(m, out, glossy(n, "Anisotropic BSDF", "MULTI_GGX", 0.5, anisotropy=0.5,
                                idname="ShaderNodeBsdfAnisotropic").outputs[0])
     else:
-        m, n, out = lib.material(name, "ok", "4.x compensates anisotropic Multiscatter GGX with the "
-                                             "isotropic table: furnace 0.905, a loss, but no twin "
-                                             "(twin_cell == cell), so the verdict cannot be loses")
+        m, n, out = lib.material(name, "loses", "4.x compensates anisotropic Multiscatter GGX with "
+                                                "the isotropic table: furnace 0.905, a loss no "
+                                                "Blender node restores (no twin: the rule decides)")
         surface(m, out, glossy(n, "Glossy BSDF", "MULTI_GGX", 0.5, anisotropy=0.5).outputs[0])
         lib.expect(m, "anisotropic-multiscatter", "Glossy BSDF")
 
@@ -277,9 +277,9 @@ def rules_file(path):
     for roughness, label in ((0.5, "r05"), (0.0, "r0")):
         fires = roughness > 0
         m, n, out = lib.material(
-            "refraction-ggx-%s" % label, "ok",
-            "rough single-scatter refraction loses light but has no conserving twin (twin_cell == cell), "
-            "so the furnace cannot judge it loses (furnace 0.994); never above 100 %" if fires else
+            "refraction-ggx-%s" % label, "loses" if fires else "ok",
+            "rough single-scatter refraction loses light (furnace 0.994) and has no conserving "
+            "twin: the losing rule decides" if fires else
             "smooth refraction (r=0): no rule; never above 100 %")
         refraction = n.new("ShaderNodeBsdfRefraction")
         refraction.name = "Refraction BSDF"
@@ -499,7 +499,8 @@ def unusual_file(path):
     surface(m, out, emission.outputs[0])
     lib.expect(m, "emission", "Emission")
 
-    m, n, out = lib.material("holdout", "error", "a Holdout renders nothing to judge (alpha 0)")
+    m, n, out = lib.material("holdout", "ok", "a Holdout renders nothing to judge (alpha 0): "
+                                              "reported, not judged")
     holdout = n.new("ShaderNodeHoldout")
     holdout.name = "Holdout"
     surface(m, out, holdout.outputs[0])
@@ -514,9 +515,9 @@ def unusual_file(path):
     link(m.node_tree, absorption.outputs[0], out.inputs["Volume"])
     lib.expect(m, "volume", "Material Output")
 
-    m, n, out = lib.material("osl-script", "ok",
-                             "an OSL Script node (internal): the audit cannot read it; the SVM furnace "
-                             "renders it black (0.00, alpha 1), which neither creates nor (no twin) loses")
+    m, n, out = lib.material("osl-script", "error",
+                             "an OSL Script node (internal): the audit cannot read it, and the SVM "
+                             "furnace renders it black (0.00, alpha 1): it could not be audited")
     text = bpy.data.texts.new("tiny.osl")
     text.write(OSL_SOURCE)
     script = n.new("ShaderNodeScript")

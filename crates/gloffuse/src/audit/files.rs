@@ -113,7 +113,9 @@ mod tests {
             text,
             dir.path().to_path_buf(),
         ] {
-            let e = blend_files(std::slice::from_ref(&bad)).unwrap_err().to_string();
+            let e = blend_files(std::slice::from_ref(&bad))
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(&bad.display().to_string()), "{e}");
         }
     }

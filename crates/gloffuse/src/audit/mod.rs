@@ -89,7 +89,7 @@ pub fn audit(
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
     check(o)?;
-    files::blend_files(&o.paths)?;
+    check_fix_inputs(o, &files::blend_files(&o.paths)?)?;
     let blender = o.blender.find(progress)?;
     audit_with(&blender, o, progress, on_file)
 }
@@ -103,6 +103,7 @@ pub fn audit_with(
 ) -> Result<AuditReport, Error> {
     check(o)?;
     let files = files::blend_files(&o.paths)?;
+    check_fix_inputs(o, &files)?;
     let fix_targets = fix_targets(o, &files, blender)?;
     let mut twins = TwinGroups::new(blender);
     let counts: Vec<usize> = files
@@ -211,6 +212,24 @@ fn check(o: &AuditOptions) -> Result<(), Error> {
     Ok(())
 }
 
+/// `--fix OUT` takes one input file.
+fn check_fix_inputs(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
+    match &o.fix {
+        FixTarget::File(out) if files.len() != 1 => Err(Error::input(
+            Field::Fix,
+            out.display(),
+            Hint::new(
+                format!(
+                    "one input .blend ({} were found): for several, use {{}}",
+                    files.len()
+                ),
+                [Field::FixDir],
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// How one file's fix is written.
 struct FixPlan {
     /// The input, checked (its header: version and compression).
@@ -232,21 +251,6 @@ fn fix_targets(
         FixTarget::Dir(_) => Field::FixDir,
         FixTarget::InPlace => Field::InPlace,
     };
-    if let FixTarget::File(out) = &o.fix
-        && files.len() != 1
-    {
-        return Err(Error::input(
-            Field::Fix,
-            out.display(),
-            Hint::new(
-                format!(
-                    "one input .blend ({} were found): for several, use {{}}",
-                    files.len()
-                ),
-                [Field::FixDir],
-            ),
-        ));
-    }
     files
         .iter()
         .map(|file| {
