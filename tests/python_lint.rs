@@ -67,6 +67,8 @@ fn every_bundled_script_passes_ruff() {
     let scripts = [
         ("generate.py", assemble(&document, Job::Generate)),
         ("furnace.py", assemble(&document, Job::Furnace)),
+        ("audit.py", assemble(&document, Job::Audit)),
+        ("bench_library.py", assemble(&document, Job::BenchLibrary)),
         (
             "material_scene.py",
             assemble_with_main(
