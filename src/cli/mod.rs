@@ -3,8 +3,10 @@
 //!
 //! Exit codes, one rule each:
 //!
-//! - 0: the command succeeded (for `verify` and `refresh`: every sphere passed);
-//! - 1: a check failed (`verify` or `refresh` found a sphere outside its tolerance);
+//! - 0: the command succeeded (for `verify` and `refresh`: every sphere passed; for `audit`:
+//!   no material has a verdict the check fails on);
+//! - 1: a check failed (`verify` or `refresh` found a sphere outside its tolerance, `audit`
+//!   a material with a failing verdict);
 //! - 2: an error (bad input, Blender failed, an output could not be written);
 //! - 128 + the signal's number when stopped by a signal: 130 for Ctrl-C (SIGINT), 143 for
 //!   SIGTERM (`timeout`, a CI cancel), 129 for SIGHUP. Blender is stopped and nothing is
@@ -39,7 +41,7 @@ use progress::{Terminal, eprintln_quietly};
 /// How a command ended, when it did not fail.
 enum Outcome {
     Success,
-    /// A check (`verify`, `refresh`) found a sphere outside its tolerance.
+    /// A check (`verify`, `refresh`, `audit`) found a sphere or material outside its tolerance.
     CheckFailed,
 }
 

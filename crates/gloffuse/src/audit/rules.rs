@@ -25,6 +25,17 @@ pub enum Effect {
     Error,
 }
 
+impl Effect {
+    pub fn key(self) -> &'static str {
+        match self {
+            Effect::Loses => "loses",
+            Effect::Creates => "creates",
+            Effect::Info => "info",
+            Effect::Error => "error",
+        }
+    }
+}
+
 /// One rule of the audit.
 #[derive(Clone, Copy, Debug)]
 pub struct Rule {
@@ -320,6 +331,25 @@ mod tests {
         let m = rule("metallic-single-scatter").unwrap();
         assert!(!m.applies(v(4, 2)) && m.applies(v(4, 3)) && m.applies(v(5, 0)));
         assert_eq!(m.versions(), "4.3 and later");
+    }
+
+    /// docs/AUDIT.md lists every rule, with the effect and versions the catalogue gives it.
+    #[test]
+    fn the_documentation_lists_every_rule_as_the_catalogue_has_it() {
+        let doc = include_str!("../../../../docs/AUDIT.md");
+        let section = doc.split("\n## Rules\n").nth(1).expect("a Rules section");
+        let section = section.split("\n## ").next().unwrap_or(section);
+        let rows: Vec<Vec<&str>> = section
+            .lines()
+            .filter(|l| l.starts_with("| `"))
+            .map(|l| l.split('|').map(str::trim).collect())
+            .collect();
+        assert_eq!(rows.len(), RULES.len(), "one row per rule");
+        for (row, rule) in rows.iter().zip(RULES) {
+            assert_eq!(row[1], format!("`{}`", rule.id), "in the catalogue's order");
+            assert_eq!(row[2], rule.effect.key(), "{}", rule.id);
+            assert_eq!(row[3], rule.versions(), "{}", rule.id);
+        }
     }
 
     #[test]

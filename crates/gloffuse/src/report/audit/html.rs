@@ -113,7 +113,7 @@ fn card(m: &AuditedMaterial, picture: Option<String>) -> String {
                 escape(&f.fix),
                 f.twin
                     .as_ref()
-                    .map(|t| format!(" The twin uses {}.", escape(t)))
+                    .map(|t| format!(" In the twin: {}.", escape(t)))
                     .unwrap_or_default()
             ));
         }

@@ -18,24 +18,30 @@ use crate::verify::image::Rgba;
 /// The folder of material pictures, inside the report folder.
 const PICTURES: &str = "materials";
 
-/// The report folder while the audit runs: each file's pictures are written as it is done.
+/// The report folder while the audit runs: each file's pictures are written as it is done,
+/// into a temporary folder inside it that becomes `materials/` when the report is finished
+/// (an audit stopped half-way leaves no pictures behind).
 pub struct ReportDir {
     dir: PathBuf,
+    staging: tempfile::TempDir,
     /// Per material, in report order: its picture's path relative to the folder, if rendered.
     pictures: Vec<Option<String>>,
 }
 
 impl ReportDir {
-    /// Makes `dir` (its parent must exist) and its picture folder.
+    /// Makes `dir` (its parent must exist) and the temporary picture folder in it.
     pub fn create(dir: &Path) -> Result<Self, Error> {
         output::make_report_dir(dir)?;
-        let pictures = dir.join(PICTURES);
-        std::fs::create_dir_all(&pictures).map_err(|e| Error::Write {
-            path: pictures,
-            message: e.to_string(),
-        })?;
+        let staging = tempfile::Builder::new()
+            .prefix(".gloffuse-materials-")
+            .tempdir_in(dir)
+            .map_err(|e| Error::Write {
+                path: dir.to_path_buf(),
+                message: e.to_string(),
+            })?;
         Ok(ReportDir {
             dir: dir.to_path_buf(),
+            staging,
             pictures: Vec::new(),
         })
     }
@@ -45,17 +51,18 @@ impl ReportDir {
         for m in done.materials {
             let picture = match (done.image, done.file.grid, m.cells) {
                 (Some(image), Some((columns, cell)), Some((own, twin))) => {
-                    let name = format!("{PICTURES}/{:05}.png", self.pictures.len());
+                    let file = format!("{:05}.png", self.pictures.len());
+                    let path = self.staging.path().join(&file);
                     let rgb = strip(image, columns, cell, own, twin);
                     let bytes =
                         encode_png(&rgb, ((3 * cell) as u32, cell as u32)).map_err(|message| {
                             Error::Write {
-                                path: self.dir.join(&name),
+                                path: path.clone(),
                                 message,
                             }
                         })?;
-                    write_output(&self.dir.join(&name), &bytes)?;
-                    Some(name)
+                    write_output(&path, &bytes)?;
+                    Some(format!("{PICTURES}/{file}"))
                 }
                 _ => None,
             };
@@ -64,8 +71,24 @@ impl ReportDir {
         Ok(())
     }
 
-    /// Writes report.json and report.html; returns every path written at the top.
+    /// Puts the pictures in place as `materials/` (replacing an earlier report's), writes
+    /// report.json and report.html; returns every path written at the top.
     pub fn finish(self, report: &AuditReport, rerun: &str) -> Result<Vec<PathBuf>, Error> {
+        let pictures = self.dir.join(PICTURES);
+        let fail = |e: std::io::Error| Error::Write {
+            path: pictures.clone(),
+            message: e.to_string(),
+        };
+        let staged = self.staging.keep();
+        if pictures.is_dir() {
+            // The old folder moves aside, the new one takes its name, then the old goes.
+            let old = staged.with_extension("old");
+            std::fs::rename(&pictures, &old).map_err(fail)?;
+            std::fs::rename(&staged, &pictures).map_err(fail)?;
+            std::fs::remove_dir_all(&old).map_err(fail)?;
+        } else {
+            std::fs::rename(&staged, &pictures).map_err(fail)?;
+        }
         let json = self.dir.join("report.json");
         let text = serde_json::to_string_pretty(report).expect("reports serialise to JSON");
         write_output(&json, text.as_bytes())?;
