@@ -758,11 +758,11 @@ pub struct AuditArgs {
     #[arg(long, default_value_t = verify_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub resolution: u32,
 
-    /// Samples per pixel.
+    /// Samples per pixel (the default keeps a sphere's standard error near 0.2 %).
     #[arg(long, default_value_t = verify_defaults().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub spp: u32,
 
-    /// Cycles' random seed.
+    /// Cycles' random seed (another seed gives the same means with fresh noise).
     #[arg(long, default_value_t = verify_defaults().render.seed)]
     pub seed: u32,
 

@@ -126,17 +126,26 @@ pub fn make_library(blender: &Path, dir: &Path, gloffuse_library: Option<&Path>)
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}\n{text}", expected.display()))
 }
 
-/// `gloffuse generate --blend DIR/gloffuse-view.blend --mode view` in `blender`: the
-/// gloffuse library whose `Gloffuse View (GGX)` corrected.blend uses (with its catalog file
-/// beside it: give it a folder of its own, not the audited library's).
+/// The gloffuse library whose `Gloffuse View (GGX)` corrected.blend uses: the script of
+/// `gloffuse generate --script DIR/gloffuse-view.py --mode view`, saved by `blender` as
+/// DIR/gloffuse-view.blend (the groups `--blend` builds, without its asset previews, which
+/// the audit does not need).
 pub fn view_library(blender: &Path, dir: &Path) -> PathBuf {
+    let script = dir.join("gloffuse-view.py");
     let library = dir.join("gloffuse-view.blend");
     super::gloffuse()
-        .args(["generate", "--no-provision", "--mode", "view", "--blend"])
-        .arg(&library)
-        .arg("--blender")
-        .arg(blender)
+        .args(["generate", "--mode", "view", "--script"])
+        .arg(&script)
         .assert()
         .success();
+    let run =
+        super::blender::run_in_blender(blender, &script, &["--save".as_ref(), library.as_os_str()]);
+    assert!(
+        run.status.success() && library.is_file(),
+        "the view library in {} ({}):\n{}",
+        blender.display(),
+        run.status,
+        String::from_utf8_lossy(&run.stderr)
+    );
     library
 }
