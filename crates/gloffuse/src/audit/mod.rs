@@ -131,7 +131,7 @@ pub fn audit_with(
             materials: *materials,
             on_fraction: &|f: f64| progress.set(done + (f.min(1.0) * *materials as f64) as u64),
         };
-        let (audited_file, mut materials_done, image) =
+        let (mut audited_file, mut materials_done, image) =
             match audit_file(&settings, &mut twins, file, fix.as_ref(), o, &mut predictor) {
                 Err(e @ Error::Interrupted { .. }) => {
                     progress.end();
@@ -140,7 +140,7 @@ pub fn audit_with(
                 Err(e) => (failed_file(file, &e), Vec::new(), None),
                 Ok(ok) => ok,
             };
-        if let Some(fixed) = &audited_file.fixed {
+        if let Some(fixed) = &mut audited_file.fixed {
             match after(
                 &settings,
                 &mut twins,
@@ -152,7 +152,7 @@ pub fn audit_with(
                     progress.end();
                     return Err(e);
                 }
-                Err(_) => {}
+                Err(e) => fixed.after_error = Some(e.to_string()),
                 Ok(after) => attach_after(&mut materials_done, after),
             }
         }
@@ -496,6 +496,7 @@ fn install_fix(
                 path: fix.input.real.display().to_string(),
                 replaced,
                 backup: Some(backup.display().to_string()),
+                after_error: None,
             }))
         }
         Some(dest) => {
@@ -507,6 +508,7 @@ fn install_fix(
                 path: dest.display().to_string(),
                 replaced,
                 backup: None,
+                after_error: None,
             }))
         }
     }

@@ -128,6 +128,8 @@ pub struct Fixed {
     pub replaced: usize,
     /// With `--in-place`: where the previous version was kept.
     pub backup: Option<String>,
+    /// Why the fixed file could not be audited again (its materials then have no `after`).
+    pub after_error: Option<String>,
 }
 
 /// One audited .blend.

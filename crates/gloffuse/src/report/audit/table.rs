@@ -70,6 +70,11 @@ pub fn render(report: &AuditReport) -> String {
                 "\nfixed   {} → {} ({} lobes replaced)\n",
                 f.file, fixed.path, fixed.replaced
             ));
+            if let Some(e) = &fixed.after_error {
+                s.push_str(&format!(
+                    "        the fixed file could not be audited again: {e}\n"
+                ));
+            }
         }
     }
     let c = &report.counts;
