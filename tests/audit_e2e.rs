@@ -407,6 +407,28 @@ fn bad_input_is_refused_and_fail_on_chooses_the_failing_verdicts() {
     };
     let library = tempfile::tempdir().unwrap();
     make_library(&blender, library.path(), None);
+    // A file Blender cannot open is that file's error; the other file is still audited.
+    let broken = library.path().join("broken.blend");
+    std::fs::write(&broken, "BLENDER-v405 but nothing after").unwrap();
+    let linked = library.path().join("linked.blend");
+    let (code, report, stderr) = audit(
+        &blender,
+        &[
+            broken.as_os_str(),
+            linked.as_os_str(),
+            "--no-render".as_ref(),
+        ],
+    );
+    assert_eq!(code, 1, "{stderr}");
+    assert_eq!(report["counts"]["files_failed"], 1, "{report}");
+    assert!(
+        report["files"][0]["error"]
+            .as_str()
+            .unwrap()
+            .contains("broken.blend")
+    );
+    assert!(material(&report, "linked.blend", "local-diffuse")["verdict"] == "ok");
+    std::fs::remove_file(&broken).unwrap();
     let unusual = library.path().join("unusual.blend");
     let (code, _, _) = audit(&blender, &[unusual.as_os_str(), "--no-render".as_ref()]);
     assert_eq!(

@@ -156,6 +156,8 @@ pub struct AuditedFile {
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Counts {
     pub files: usize,
+    /// Files Blender could not audit (their materials are missing from the counts).
+    pub files_failed: usize,
     pub materials: usize,
     pub ok: usize,
     pub loses: usize,
@@ -192,6 +194,7 @@ impl AuditReport {
     pub fn finish(&mut self) {
         let mut counts = Counts {
             files: self.files.len(),
+            files_failed: self.files.iter().filter(|f| f.error.is_some()).count(),
             materials: self.materials.len(),
             ..Counts::default()
         };
@@ -204,7 +207,7 @@ impl AuditReport {
             } += 1;
         }
         let fails = |v: Verdict| self.settings.fail_on.contains(&v);
-        let file_failed = self.files.iter().any(|f| f.error.is_some()) && fails(Verdict::Error);
+        let file_failed = counts.files_failed > 0 && fails(Verdict::Error);
         self.passed = !file_failed && !self.materials.iter().any(|m| fails(m.verdict));
         self.counts = counts;
     }

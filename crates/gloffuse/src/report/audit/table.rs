@@ -79,8 +79,13 @@ pub fn render(report: &AuditReport) -> String {
     }
     let c = &report.counts;
     let failing: Vec<&str> = report.settings.fail_on.iter().map(|v| v.key()).collect();
+    let unread = match c.files_failed {
+        0 => String::new(),
+        1 => ", 1 file could not be audited".to_string(),
+        n => format!(", {n} files could not be audited"),
+    };
     s.push_str(&format!(
-        "\n{}: {} ok, {} lose energy, {} create energy, {} errors (failing on: {})\n",
+        "\n{}: {} ok, {} lose energy, {} create energy, {} errors{unread} (failing on: {})\n",
         if report.passed { "PASS" } else { "FAIL" },
         c.ok,
         c.loses,
