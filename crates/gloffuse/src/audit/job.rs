@@ -4,8 +4,6 @@
 //! in the white furnace and, when asked, saves a fixed copy.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
 
 use std::collections::BTreeMap;
 
@@ -13,12 +11,12 @@ use serde::{Deserialize, Serialize};
 
 use super::rules::{RuleRange, ranges};
 use crate::Error;
-use crate::blender::{Blender, BlenderOptions, Run, RunOutput, run_script, runs};
+use crate::blender::{Blender, BlenderOptions, Run, runs};
 use crate::generate::{GenerateParams, Job, assemble, layered_group_name, multiscatter_group_name};
 use crate::measure::{Distribution, Engine};
 use crate::output::write_output;
 use crate::verify::RenderSettings;
-use crate::verify::render::last_sample;
+use crate::verify::render::run_watching_samples;
 
 /// The `audit` section of the job's parameter document.
 #[derive(Clone, Debug, Serialize)]
@@ -197,7 +195,8 @@ pub fn run_job(
         cancel: s.options.cancel.clone(),
         log: log.clone(),
     };
-    let out = followed(&run, render.samples, s.on_fraction)?;
+    let samples = f64::from(render.samples.max(1));
+    let out = run_watching_samples(&run, &|n| (s.on_fraction)(n as f64 / samples))?;
     let result: JobResult = serde_json::from_value(out.result).map_err(|e| Error::Blender {
         message: format!("the audit job's result line is not what gloffuse expects ({e})").into(),
         log: Some(log.clone()),
@@ -205,28 +204,6 @@ pub fn run_job(
     })?;
     let exr = (s.render.is_some() && result.output.is_some()).then_some(exr);
     Ok(JobRun { result, log, exr })
-}
-
-/// Runs `run` while a watcher reports the fraction of `samples` Cycles has logged.
-fn followed(
-    run: &Run,
-    samples: u32,
-    on_fraction: &(dyn Fn(f64) + Sync),
-) -> Result<RunOutput, Error> {
-    let done = AtomicBool::new(false);
-    std::thread::scope(|scope| {
-        scope.spawn(|| {
-            while !done.load(Ordering::Relaxed) {
-                if let Some(n) = last_sample(&run.log) {
-                    on_fraction(n as f64 / f64::from(samples.max(1)));
-                }
-                std::thread::sleep(Duration::from_millis(200));
-            }
-        });
-        let outcome = run_script(run);
-        done.store(true, Ordering::Relaxed);
-        outcome
-    })
 }
 
 #[cfg(test)]

@@ -103,13 +103,23 @@ fn run_followed(run: &Run, plan: &Plan, progress: &dyn Progress) -> Result<RunOu
         ),
         u64::from(plan.settings.samples),
     );
-    // A watcher follows Cycles' "Sample N/M" lines in the log while Blender runs.
+    let outcome = run_watching_samples(run, &|s| progress.set(s));
+    progress.end();
+    outcome
+}
+
+/// Runs `run` while a watcher passes `on_sample` each "Sample N" Cycles logs (the highest
+/// so far, every 200 ms).
+pub(crate) fn run_watching_samples(
+    run: &Run,
+    on_sample: &(dyn Fn(u64) + Sync),
+) -> Result<RunOutput, Error> {
     let done = AtomicBool::new(false);
-    let outcome = std::thread::scope(|scope| {
+    std::thread::scope(|scope| {
         scope.spawn(|| {
             while !done.load(Ordering::Relaxed) {
                 if let Some(s) = last_sample(&run.log) {
-                    progress.set(s);
+                    on_sample(s);
                 }
                 std::thread::sleep(Duration::from_millis(200));
             }
@@ -117,9 +127,7 @@ fn run_followed(run: &Run, plan: &Plan, progress: &dyn Progress) -> Result<RunOu
         let outcome = run_script(run);
         done.store(true, Ordering::Relaxed);
         outcome
-    });
-    progress.end();
-    outcome
+    })
 }
 
 /// The rendered EXR, which must be as large as `plan` needs; a failure names the render's
@@ -151,7 +159,7 @@ fn read_sweep(exr: &Path, plan: &Plan, log: &Path, command: &str) -> Result<Rgba
 }
 
 /// The highest "Sample N/M" Cycles has logged so far.
-pub(crate) fn last_sample(log: &Path) -> Option<u64> {
+fn last_sample(log: &Path) -> Option<u64> {
     let text = std::fs::read(log).ok()?;
     let text = String::from_utf8_lossy(&text);
     let at = text.rfind("Sample ")?;
