@@ -88,10 +88,10 @@ pub fn audit(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    check(o)?;
-    check_fix_inputs(o, &files::blend_files(&o.paths)?)?;
+    // Bad input fails before Blender is looked for.
+    let files = checked_files(o)?;
     let blender = o.blender.find(progress)?;
-    audit_with(&blender, o, progress, on_file)
+    audit_files(&blender, o, &files, progress, on_file)
 }
 
 /// [`audit`] with a Blender already found.
@@ -101,10 +101,25 @@ pub fn audit_with(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
+    audit_files(blender, o, &checked_files(o)?, progress, on_file)
+}
+
+/// The options checked, and the files they name.
+fn checked_files(o: &AuditOptions) -> Result<Vec<PathBuf>, Error> {
     check(o)?;
     let files = files::blend_files(&o.paths)?;
     check_fix_inputs(o, &files)?;
-    let fix_targets = fix_targets(o, &files, blender)?;
+    Ok(files)
+}
+
+fn audit_files(
+    blender: &Blender,
+    o: &AuditOptions,
+    files: &[PathBuf],
+    progress: &dyn Progress,
+    on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
+) -> Result<AuditReport, Error> {
+    let fix_targets = fix_targets(o, files, blender)?;
     let mut twins = TwinGroups::new(blender);
     let counts: Vec<usize> = files
         .iter()
