@@ -2,13 +2,9 @@
 //! first) with its picture (as authored | conserving twin | difference), its numbers and
 //! its findings with their fixes.
 
+use super::table::{order, pct};
 use crate::audit::{AuditReport, AuditedMaterial};
-use crate::report::audit::table::order;
 use crate::report::html::escape;
-
-fn pct(x: Option<f64>) -> String {
-    x.map_or_else(|| "—".to_string(), |x| format!("{:.1} %", 100.0 * x))
-}
 
 /// `pictures[i]` is material i's picture (report order), relative to the page.
 pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) -> String {
@@ -57,12 +53,7 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             escape(f.error.as_deref().unwrap_or_default())
         ));
     }
-    for m in order(report) {
-        let index = report
-            .materials
-            .iter()
-            .position(|o| std::ptr::eq(o, m))
-            .expect("ordered from the report");
+    for (index, m) in order(report) {
         s.push_str(&card(m, pictures.get(index).cloned().flatten()));
     }
     s.push_str("</body></html>\n");

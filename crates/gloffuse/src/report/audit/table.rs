@@ -1,16 +1,18 @@
 //! The audit verdict for a terminal: one line per material (failures first), then its
 //! findings, the file findings, and the counts.
 
-use crate::audit::{AuditReport, AuditedMaterial, Verdict};
+use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Verdict};
 
-fn pct(x: Option<f64>) -> String {
+/// A brightness in percent, or a dash where there is none.
+pub(super) fn pct(x: Option<f64>) -> String {
     x.map_or_else(|| "—".to_string(), |x| format!("{:.1} %", 100.0 * x))
 }
 
-/// Failures first (creates, loses, error), then the rest, each in report order.
-pub fn order(report: &AuditReport) -> Vec<&AuditedMaterial> {
-    let mut ms: Vec<&AuditedMaterial> = report.materials.iter().collect();
-    ms.sort_by_key(|m| m.verdict);
+/// Failures first (creates, loses, error), then the rest, each in report order, with its
+/// index in the report.
+pub fn order(report: &AuditReport) -> Vec<(usize, &AuditedMaterial)> {
+    let mut ms: Vec<(usize, &AuditedMaterial)> = report.materials.iter().enumerate().collect();
+    ms.sort_by_key(|(_, m)| m.verdict);
     ms
 }
 
@@ -27,7 +29,7 @@ pub fn render(report: &AuditReport) -> String {
         "{:<8} {:>8} {:>8} {:>8}  {}\n",
         "verdict", "mean", "rim", "twin", "material (file) — findings"
     ));
-    for m in order(report) {
+    for (_, m) in order(report) {
         let rules: Vec<&str> = m.findings.iter().map(|f| f.rule.as_str()).collect();
         s.push_str(&format!(
             "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
@@ -56,26 +58,7 @@ pub fn render(report: &AuditReport) -> String {
         }
     }
     for f in &report.files {
-        if let Some(e) = &f.error {
-            s.push_str(&format!("\nerror   {}: {e}\n", f.file));
-        }
-        for finding in &f.findings {
-            s.push_str(&format!(
-                "\n{}: {} — {}\n",
-                f.file, finding.rule, finding.why
-            ));
-        }
-        if let Some(fixed) = &f.fixed {
-            s.push_str(&format!(
-                "\nfixed   {} → {} ({} lobes replaced)\n",
-                f.file, fixed.path, fixed.replaced
-            ));
-            if let Some(e) = &fixed.after_error {
-                s.push_str(&format!(
-                    "        the fixed file could not be audited again: {e}\n"
-                ));
-            }
-        }
+        s.push_str(&file_lines(f));
     }
     let c = &report.counts;
     let failing: Vec<&str> = report.settings.fail_on.iter().map(|v| v.key()).collect();
@@ -93,6 +76,32 @@ pub fn render(report: &AuditReport) -> String {
         c.error,
         failing.join(", ")
     ));
+    s
+}
+
+/// A file's error, its own findings and its fix, each on a line of its own.
+fn file_lines(f: &AuditedFile) -> String {
+    let mut s = String::new();
+    if let Some(e) = &f.error {
+        s.push_str(&format!("\nerror   {}: {e}\n", f.file));
+    }
+    for finding in &f.findings {
+        s.push_str(&format!(
+            "\n{}: {} — {}\n",
+            f.file, finding.rule, finding.why
+        ));
+    }
+    if let Some(fixed) = &f.fixed {
+        s.push_str(&format!(
+            "\nfixed   {} → {} ({} lobes replaced)\n",
+            f.file, fixed.path, fixed.replaced
+        ));
+        if let Some(e) = &fixed.after_error {
+            s.push_str(&format!(
+                "        the fixed file could not be audited again: {e}\n"
+            ));
+        }
+    }
     s
 }
 
