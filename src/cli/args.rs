@@ -19,6 +19,7 @@ use gloffuse::lut::{Bits, Format, GModel, Kind, LutOptions, Method};
 use gloffuse::measure::brdf::{Model, ModelParams};
 use gloffuse::measure::{BlenderVersion, Distribution, Engine, Roughness};
 use gloffuse::refresh::RefreshOptions;
+use gloffuse::shard::Shard;
 use gloffuse::verify::plan::default_samples;
 use gloffuse::verify::{Judging, LAYERED_IOR, RenderSettings, VerifyOptions, layered_roughness};
 
@@ -120,6 +121,24 @@ pub enum Command {
     Lut(LutArgs),
     /// Time the verify sweep as one Blender process against one process per sphere.
     Bench(BenchArgs),
+    /// Run a sharded audit on a farm: a Slurm array job, or an Open Job Description template.
+    ///
+    /// Writes into --out what the farm runs: one `gloffuse audit … --shard K/N` task per
+    /// shard, each writing DIR/shard-K/ and DIR/shard-K.xml, then one `gloffuse report merge`
+    /// task after them all, writing DIR/merged/ (report.html, report.json, pictures),
+    /// DIR/merged.json and DIR/merged.xml: the report one unsharded audit gives. DIR must be
+    /// on a filesystem every node shares; each node needs gloffuse (--gloffuse) and a
+    /// Blender (pass `-- --blender PATH`, or let each node find or install its own).
+    #[command(after_long_help = FARM_EXAMPLES)]
+    Farm {
+        #[command(subcommand)]
+        action: FarmCommand,
+    },
+    /// Work on reports: join the shards of a farm run into one.
+    Report {
+        #[command(subcommand)]
+        action: ReportCommand,
+    },
     /// Inspect coefficient files and the built-in presets.
     Coefficients {
         #[command(subcommand)]
@@ -796,12 +815,29 @@ pub struct AuditArgs {
     #[arg(long, value_name = "FILE.xml")]
     pub junit: Option<PathBuf>,
 
+    /// Audit only part K of N of the files (K from 1 to N), for a farm: every machine
+    /// computes the same split, balanced by each file's material count, and `gloffuse report
+    /// merge` joins the shards' reports into the one a single run gives.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+
+    /// Exit 0 even when materials fail the check (the verdict stays in the reports): for a
+    /// farm task whose failure would keep the merge from running. Bad input and a Blender
+    /// that cannot run still exit 2.
+    #[arg(long)]
+    pub exit_zero: bool,
+
     #[command(flatten)]
     pub blender: BlenderArgs,
 
     /// Print the JSON report instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    s.parse::<Shard>()
+        .map_err(|e| e.render(|_| "shard".to_string()))
 }
 
 fn parse_verdict(s: &str) -> Result<Verdict, String> {
@@ -838,6 +874,7 @@ impl AuditArgs {
                 _ => FixTarget::None,
             },
             allow_downgrade: self.allow_downgrade,
+            shard: self.shard,
             blender: self.blender.options(self.json),
         }
     }
@@ -949,6 +986,12 @@ pub struct BenchArgs {
     #[arg(long, value_name = "N,...", value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub audit: Vec<u64>,
 
+    /// Time a sharded audit instead: a generated library of 4·N files audited as one run,
+    /// then as N shards at once, and the farm cost model's numbers (a Blender start, a
+    /// material).
+    #[arg(long, value_name = "N", conflicts_with = "audit", value_parser = clap::value_parser!(u64).range(1..=64))]
+    pub shards: Option<u64>,
+
     #[command(flatten)]
     pub blender: BlenderArgs,
 }
@@ -1045,6 +1088,113 @@ impl LutArgs {
 }
 
 #[derive(Subcommand, Debug)]
+pub enum FarmCommand {
+    /// Write (and with --submit, submit) a Slurm array job, one task per shard, and a merge
+    /// job after it (--dependency=afterany, so it runs whatever the shards' exit codes and
+    /// its own exit code is the verdict: 0 passed, 1 failed, 2 shards missing).
+    Slurm(SlurmArgs),
+    /// Write an Open Job Description template (jobtemplate-2023-09): step Audit with one
+    /// task per shard, step Merge after it; run it with `openjd run`, or submit it to AWS
+    /// Deadline Cloud. Shards exit 0 when materials fail (OpenJD runs a step only after every
+    /// task of the one it depends on succeeded); the Merge step's exit code is the verdict.
+    Openjd(FarmArgs),
+}
+
+const FARM_EXAMPLES: &str = "Examples:
+  gloffuse farm slurm /shared/assets --shards 50 --out /shared/audit --submit
+  gloffuse farm slurm /shared/assets --shards 8 --out /shared/audit --sbatch-arg=--partition=cpu \
+      -- --blender /opt/blender-4.5/blender --spp 64
+  gloffuse farm openjd /shared/assets --shards 20 --out /shared/audit
+  openjd run /shared/audit/gloffuse-audit.template.json";
+
+#[derive(Args, Debug)]
+pub struct FarmArgs {
+    /// The .blend files or folders to audit, as every node sees them.
+    #[arg(value_name = "PATH", required = true)]
+    pub paths: Vec<PathBuf>,
+
+    /// How many shards (farm tasks) to split the files into.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub shards: u32,
+
+    /// The job's folder, shared by every node: the scripts or template, every shard's
+    /// report and the merged one (made if missing; its parent must exist).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// gloffuse on the nodes [default: this gloffuse's path].
+    #[arg(long, value_name = "PROGRAM")]
+    pub gloffuse: Option<String>,
+
+    /// More `audit` flags for every shard, after `--` (e.g. -- --spp 64 --blender PATH).
+    #[arg(last = true, value_name = "AUDIT FLAGS")]
+    pub audit_flags: Vec<String>,
+}
+
+#[derive(Args, Debug)]
+pub struct SlurmArgs {
+    #[command(flatten)]
+    pub farm: FarmArgs,
+
+    /// An sbatch option for both jobs (repeatable), e.g. --sbatch-arg=--partition=cpu.
+    #[arg(long, value_name = "OPTION", allow_hyphen_values = true)]
+    pub sbatch_arg: Vec<String>,
+
+    /// Also submit the jobs with sbatch (else run DIR/submit.sh yourself).
+    #[arg(long)]
+    pub submit: bool,
+
+    /// With --submit: print the job ids as JSON.
+    #[arg(long, requires = "submit")]
+    pub json: bool,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum ReportCommand {
+    /// Join the reports of a sharded `audit --shard K/N` into the report one run gives.
+    ///
+    /// Takes every shard's report.json (or the --report folder holding it), in any order,
+    /// and writes the same verdict, counts, JSON, JUnit and HTML (with the shards' pictures)
+    /// as an audit of all the files at once. Refuses a missing shard, a shard given twice,
+    /// and shards of different runs (another Blender, gloffuse, setting or set of files).
+    /// Exit code 0: passed; 1: some materials have a verdict in the run's --fail-on; 2: the
+    /// shards cannot be merged.
+    #[command(after_long_help = MERGE_EXAMPLES)]
+    Merge(MergeArgs),
+}
+
+const MERGE_EXAMPLES: &str = "Examples:
+  gloffuse audit assets/ --shard 1/2 --report out/shard-1     on one machine
+  gloffuse audit assets/ --shard 2/2 --report out/shard-2     on another
+  gloffuse report merge out/shard-1 out/shard-2 --report out/merged --junit out/merged.xml";
+
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// Every shard's report.json, or the --report folder that holds it.
+    #[arg(value_name = "SHARD", required = true)]
+    pub shards: Vec<PathBuf>,
+
+    /// Write the merged JSON report to this file (`-`: standard output, instead of the
+    /// table).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+
+    /// Write the merged verdict as JUnit XML.
+    #[arg(long, value_name = "FILE.xml")]
+    pub junit: Option<PathBuf>,
+
+    /// Write report.html, report.json and the materials' pictures (copied from the shards'
+    /// report folders) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+
+    /// Exit 0 even when materials fail the check (the verdict stays in the reports), for a
+    /// farm that would retry a failed task; shards that cannot be merged still exit 2.
+    #[arg(long)]
+    pub exit_zero: bool,
+}
+
+#[derive(Subcommand, Debug)]
 pub enum CoefficientsCommand {
     /// Print a readable summary of a preset or coefficients file (no argument: list presets).
     Show {
@@ -1090,6 +1240,8 @@ pub fn flag(field: Field) -> String {
         Field::Out => "--out",
         Field::Point => "--point",
         Field::Report => "--report",
+        Field::Shard => "--shard",
+        Field::ShardReport => "SHARD",
         Field::Roughness => "--roughness",
         Field::Samples => "--samples",
         Field::Script => "--script",

@@ -19,6 +19,7 @@
 //! closed pipe is an error we see (EPIPE), never a silent death.
 
 mod args;
+mod farm;
 mod progress;
 mod text;
 
@@ -29,9 +30,10 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicI32, Ordering};
 
-use args::{AlbedoArgs, Cli, CoefficientsCommand, Command, FitArgs};
+use args::{AlbedoArgs, Cli, CoefficientsCommand, Command, FarmCommand, FitArgs, ReportCommand};
 use gloffuse::Error;
 use gloffuse::albedo::AlbedoOutput;
+use gloffuse::audit::AuditReport;
 use gloffuse::blender::Cancel;
 use gloffuse::fit::{FitSummary, Shown};
 use gloffuse::output::{check_destination, is_stdout, write_output};
@@ -261,24 +263,39 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             emit(out, l.json, &written, text::lut)?;
             Ok(Outcome::Success)
         }
-        Command::Bench(b) if !b.audit.is_empty() => {
-            let r = gloffuse::bench::audit::bench_audit(&b.audit_options(), &terminal)?;
-            out.write_all(text::bench_audit(&r).as_bytes())?;
-            Ok(Outcome::Success)
-        }
-        Command::Bench(b) => {
-            let r = gloffuse::bench::bench(&b.options(), &terminal)?;
-            writeln!(
-                out,
-                "{} spheres: one Blender process {:.1} s, one process per sphere {:.1} s: {:.1}× faster",
-                r.spheres, r.one_process_seconds, r.per_sphere_seconds, r.ratio
-            )?;
-            Ok(Outcome::Success)
-        }
+        Command::Bench(b) => bench(&b, out, &terminal),
+        Command::Farm {
+            action: FarmCommand::Slurm(a),
+        } => farm::slurm_job(&a, out),
+        Command::Farm {
+            action: FarmCommand::Openjd(a),
+        } => farm::openjd_template(&a, out),
+        Command::Report {
+            action: ReportCommand::Merge(m),
+        } => merge(&m, out, &mut stderr),
         Command::Coefficients {
             action: CoefficientsCommand::Show { source, json },
         } => show(source.as_deref(), json, out),
     }
+}
+
+/// `bench`: the verify sweep, the audit (`--audit`) or sharding (`--shards`), timed.
+fn bench(b: &args::BenchArgs, out: &mut dyn Write, progress: &dyn Progress) -> Result<Outcome> {
+    if let Some(n) = b.shards {
+        let r = gloffuse::bench::shards::bench_shards(&b.audit_options(), n as usize, progress)?;
+        out.write_all(text::bench_shards(&r).as_bytes())?;
+    } else if !b.audit.is_empty() {
+        let r = gloffuse::bench::audit::bench_audit(&b.audit_options(), progress)?;
+        out.write_all(text::bench_audit(&r).as_bytes())?;
+    } else {
+        let r = gloffuse::bench::bench(&b.options(), progress)?;
+        writeln!(
+            out,
+            "{} spheres: one Blender process {:.1} s, one process per sphere {:.1} s: {:.1}× faster",
+            r.spheres, r.one_process_seconds, r.per_sphere_seconds, r.ratio
+        )?;
+    }
+    Ok(Outcome::Success)
 }
 
 /// `audit`: outputs checked first, then the audit, whose report folder takes each file's
@@ -315,14 +332,74 @@ fn audit(
             eprintln_quietly(&format!("wrote {}", p.display()));
         }
     }
-    if let Some(path) = &a.junit {
-        let xml = gloffuse::report::audit::junit::render(&report, &rerun);
+    write_audit_junit(a.junit.as_deref(), &report, &rerun)?;
+    let out = summary(out, err, &[a.junit.as_deref()]);
+    emit(out, a.json, &report, gloffuse::report::audit::table::render)?;
+    Ok(verdict(report.passed || a.exit_zero))
+}
+
+fn write_audit_junit(path: Option<&Path>, report: &AuditReport, rerun: &str) -> Result<()> {
+    if let Some(path) = path {
+        let xml = gloffuse::report::audit::junit::render(report, rerun);
         write_output(path, xml.as_bytes())?;
         eprintln_quietly(&format!("wrote {}", path.display()));
     }
-    let out = summary(out, err, &[a.junit.as_deref()]);
-    emit(out, a.json, &report, gloffuse::report::audit::table::render)?;
-    Ok(verdict(report.passed))
+    Ok(())
+}
+
+/// `report merge`: the shards read and checked, then the outputs of one unsharded audit.
+fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<Outcome> {
+    use gloffuse::audit::merge::{merge, read_report, report_json};
+    use gloffuse::report::audit::{ReportDir, picture_of};
+    if let Some(dir) = &m.report {
+        gloffuse::report::check_dir(dir)?;
+    }
+    for path in [&m.junit, &m.json].into_iter().flatten() {
+        check_destination(path)?;
+    }
+    let shards = m
+        .shards
+        .iter()
+        .map(|p| Ok((p.clone(), read_report(p)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let merged = merge(shards)?;
+    let report = &merged.report;
+    let rerun = this_command();
+    if let Some(dir) = &m.report {
+        let mut folder = ReportDir::create(dir)?;
+        let mut unpictured = std::collections::BTreeSet::new();
+        for (&(k, i), material) in merged.sources.iter().zip(&report.materials) {
+            let json = report_json(&merged.shards[k]);
+            let picture = picture_of(json.parent().unwrap_or(Path::new(".")), i);
+            let found = picture.is_file();
+            if !found && material.mean.is_some() {
+                unpictured.insert(k + 1);
+            }
+            folder.add_copy(found.then_some(picture.as_path()))?;
+        }
+        for k in unpictured {
+            eprintln_quietly(&format!(
+                "note: shard {k} has no pictures beside its report.json (run the shards with \
+                 --report DIR to have them in the merged report)"
+            ));
+        }
+        for p in folder.finish(report, &rerun)? {
+            eprintln_quietly(&format!("wrote {}", p.display()));
+        }
+    }
+    write_audit_junit(m.junit.as_deref(), report, &rerun)?;
+    if let Some(path) = &m.json {
+        let text = serde_json::to_string_pretty(report).expect("reports serialise to JSON");
+        write_output(path, format!("{text}\n").as_bytes())?;
+        if !is_stdout(path) {
+            eprintln_quietly(&format!("wrote {}", path.display()));
+        }
+    }
+    let out = summary(out, err, &[m.junit.as_deref(), m.json.as_deref()]);
+    if !m.json.as_deref().is_some_and(is_stdout) {
+        out.write_all(gloffuse::report::audit::table::render(report).as_bytes())?;
+    }
+    Ok(verdict(report.passed || m.exit_zero))
 }
 
 /// The command line this process was started with, quoted for a shell: how to rerun it.

@@ -181,6 +181,10 @@ pub enum Field {
     PointPercent,
     /// The report directory.
     Report,
+    /// Which part of a sharded run to do (K of N).
+    Shard,
+    /// A shard's report, to merge.
+    ShardReport,
     Roughness,
     Samples,
     /// The Python script to write.
@@ -234,6 +238,8 @@ impl Field {
             Field::PointRoughness => "point roughness",
             Field::PointPercent => "point percent",
             Field::Report => "report directory",
+            Field::Shard => "shard",
+            Field::ShardReport => "shard report",
             Field::Roughness => "roughness",
             Field::Samples => "samples",
             Field::Script => "script",

@@ -22,6 +22,7 @@ pub mod lut;
 pub mod output;
 pub mod refresh;
 pub mod report;
+pub mod shard;
 pub mod user_blend;
 pub mod verify;
 

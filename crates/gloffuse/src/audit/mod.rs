@@ -8,12 +8,13 @@
 pub mod files;
 pub mod job;
 pub mod judge;
+pub mod merge;
 pub mod rules;
 pub mod verdict;
 
 pub use verdict::{
     After, AuditJudging, AuditReport, AuditSettings, AuditedFile, AuditedMaterial, Counts, Finding,
-    Fixed, Verdict,
+    Fixed, ShardInput, ShardRun, Verdict,
 };
 
 use std::collections::BTreeSet;
@@ -26,6 +27,7 @@ use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Engine};
 use crate::output::{check_destination, temp_beside};
 use crate::progress::Progress;
+use crate::shard::Shard;
 use crate::user_blend::{UserBlend, read_header};
 use crate::verify::RenderSettings;
 use crate::verify::image::{Rgba, read_rgba};
@@ -56,6 +58,8 @@ pub struct AuditOptions {
     pub judging: AuditJudging,
     pub fix: FixTarget,
     pub allow_downgrade: bool,
+    /// Audit only this part of the files (the same split on every machine).
+    pub shard: Option<Shard>,
     pub blender: BlenderOptions,
 }
 
@@ -68,6 +72,7 @@ impl Default for AuditOptions {
             judging: AuditJudging::default(),
             fix: FixTarget::None,
             allow_downgrade: false,
+            shard: None,
             blender: BlenderOptions::default(),
         }
     }
@@ -119,13 +124,20 @@ fn audit_files(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    let fix_targets = fix_targets(o, files, blender)?;
-    let mut twins = TwinGroups::new(blender);
     let counts: Vec<usize> = files
         .iter()
         .map(|f| count_blocks(f, MATERIAL).unwrap_or(1))
         .collect();
     let mut report = empty_report(o, blender);
+    let (files, counts) = match o.shard {
+        None => (files.to_vec(), counts),
+        Some(shard) => {
+            report.shard = Some(shard_run(shard, files, &counts));
+            shard_part(shard, files, counts)
+        }
+    };
+    let fix_targets = fix_targets(o, &files, blender)?;
+    let mut twins = TwinGroups::new(blender);
     let mut predictor = Predictor::new(blender.version);
     let total: usize = counts.iter().sum();
     progress.begin(
@@ -186,6 +198,42 @@ fn audit_files(
     Ok(report)
 }
 
+/// What a Blender start costs, in materials' audit time: the split balances each file's
+/// materials plus one start (measured on the 2-core machine: docs/FARM.md).
+const START_COST: u64 = 19;
+
+/// Each file's cost to the split: its materials and a Blender start.
+fn file_costs(materials: &[usize]) -> Vec<u64> {
+    materials.iter().map(|&m| m as u64 + START_COST).collect()
+}
+
+/// A shard's place in the run: every file of the run, with its material count.
+fn shard_run(shard: Shard, files: &[PathBuf], counts: &[usize]) -> ShardRun {
+    ShardRun {
+        shard,
+        inputs: files
+            .iter()
+            .zip(counts)
+            .map(|(f, &materials)| ShardInput {
+                file: f.display().to_string(),
+                materials,
+            })
+            .collect(),
+    }
+}
+
+/// The files (and their material counts) `shard` audits.
+fn shard_part(shard: Shard, files: &[PathBuf], counts: Vec<usize>) -> (Vec<PathBuf>, Vec<usize>) {
+    let costs = file_costs(&counts);
+    files
+        .iter()
+        .cloned()
+        .zip(counts)
+        .zip(shard.takes(&costs))
+        .filter_map(|(kept, takes)| takes.then_some(kept))
+        .unzip()
+}
+
 /// The report before any file: how the audit runs and judges.
 fn empty_report(o: &AuditOptions, blender: &Blender) -> AuditReport {
     AuditReport {
@@ -201,6 +249,7 @@ fn empty_report(o: &AuditOptions, blender: &Blender) -> AuditReport {
             ring_tolerance: o.judging.ring_tolerance,
             fail_on: o.judging.fail_on.clone(),
         },
+        shard: None,
         passed: false,
         counts: Counts::default(),
         files: Vec::new(),

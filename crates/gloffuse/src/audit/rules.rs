@@ -5,14 +5,14 @@
 
 use std::collections::HashMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::measure::{
     AlbedoIntegrator, BlenderVersion, Distribution, Glossy, Roughness, coat::Coat,
 };
 
 /// What a flagged node does to a material's brightness.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Effect {
     /// Reflects less than it should: energy single scattering loses.

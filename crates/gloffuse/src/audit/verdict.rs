@@ -1,12 +1,13 @@
 //! The audit's verdict as data: one [`AuditedMaterial`] per material, its [`Finding`]s,
 //! the files, the counts and whether the check passed.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::rules::Effect;
+use crate::shard::Shard;
 
 /// What the furnace and the rules say about one material.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
     /// It creates energy: brighter than the light it receives.
@@ -37,7 +38,7 @@ impl Verdict {
 }
 
 /// Thresholds of the furnace verdict.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AuditJudging {
     /// Allowed excess of the mean over 1, and of the twin's mean over the material's (0.01 = 1 %).
     pub tolerance: f64,
@@ -58,7 +59,7 @@ impl Default for AuditJudging {
 }
 
 /// One flagged node.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Finding {
     pub rule: String,
     /// `Material ▸ Group node ▸ Node`.
@@ -79,7 +80,7 @@ pub struct Finding {
 }
 
 /// Furnace brightness of one sphere (1.0 = 100 %).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Brightness {
     pub mean: f64,
     pub center: f64,
@@ -91,14 +92,14 @@ pub struct Brightness {
 }
 
 /// The after-fix audit of a material.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct After {
     pub verdict: Verdict,
     pub mean: Option<f64>,
     pub findings: usize,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AuditedMaterial {
     pub file: String,
     pub material: String,
@@ -122,7 +123,7 @@ pub struct AuditedMaterial {
     pub after: Option<After>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Fixed {
     pub path: String,
     pub replaced: usize,
@@ -133,7 +134,7 @@ pub struct Fixed {
 }
 
 /// One audited .blend.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AuditedFile {
     pub file: String,
     /// The Blender version that saved it, from its header.
@@ -153,7 +154,7 @@ pub struct AuditedFile {
     pub fixed: Option<Fixed>,
 }
 
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Counts {
     pub files: usize,
     /// Files Blender could not audit (their materials are missing from the counts).
@@ -166,7 +167,7 @@ pub struct Counts {
 }
 
 /// How the materials were rendered.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AuditSettings {
     pub cell: u32,
     pub samples: u32,
@@ -177,16 +178,35 @@ pub struct AuditSettings {
     pub fail_on: Vec<Verdict>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AuditReport {
     pub gloffuse_version: String,
     pub blender_version: String,
     pub blender_program: String,
     pub settings: AuditSettings,
+    /// Set in a shard's report (`--shard K/N`): which part it is, and the whole run's inputs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardRun>,
     pub passed: bool,
     pub counts: Counts,
     pub files: Vec<AuditedFile>,
     pub materials: Vec<AuditedMaterial>,
+}
+
+/// A shard's place in its run. The inputs are the same in every shard of a run: a merge
+/// checks them and puts the files back in their order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShardRun {
+    pub shard: Shard,
+    /// Every file of the run, in order, with its materials as counted from its blocks (the
+    /// cost the split balances).
+    pub inputs: Vec<ShardInput>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShardInput {
+    pub file: String,
+    pub materials: usize,
 }
 
 impl AuditReport {

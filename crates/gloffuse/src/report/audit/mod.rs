@@ -51,7 +51,7 @@ impl ReportDir {
         for m in done.materials {
             let picture = match (done.image, done.file.grid, m.cells) {
                 (Some(image), Some((columns, cell)), Some((own, twin))) => {
-                    let file = format!("{:05}.png", self.pictures.len());
+                    let file = picture_name(self.pictures.len());
                     let path = self.staging.path().join(&file);
                     let rgb = strip(image, columns, cell, own, twin);
                     let bytes =
@@ -68,6 +68,24 @@ impl ReportDir {
             };
             self.pictures.push(picture);
         }
+        Ok(())
+    }
+
+    /// Adds the next material's picture as a copy of `from` (a shard's picture), if any.
+    pub fn add_copy(&mut self, from: Option<&Path>) -> Result<(), Error> {
+        let picture = match from {
+            Some(from) => {
+                let file = picture_name(self.pictures.len());
+                let path = self.staging.path().join(&file);
+                std::fs::copy(from, &path).map_err(|e| Error::Write {
+                    path: path.clone(),
+                    message: format!("copying {}: {e}", from.display()),
+                })?;
+                Some(format!("{PICTURES}/{file}"))
+            }
+            None => None,
+        };
+        self.pictures.push(picture);
         Ok(())
     }
 
@@ -99,6 +117,16 @@ impl ReportDir {
         )?;
         Ok(vec![json, page, self.dir.join(PICTURES)])
     }
+}
+
+/// The picture of the material at `index` of a report's materials, in the folder `dir`
+/// holding that report (it exists if the material was rendered).
+pub fn picture_of(dir: &Path, index: usize) -> PathBuf {
+    dir.join(PICTURES).join(picture_name(index))
+}
+
+fn picture_name(index: usize) -> String {
+    format!("{index:05}.png")
 }
 
 /// Three cells side by side, row by row: the material, its twin, and the relative

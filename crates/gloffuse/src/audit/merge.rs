@@ -1,0 +1,170 @@
+//! Joins the reports of a sharded audit (`--shard K/N`) into the report one unsharded run
+//! gives: the same files and materials in the same order, counts and verdict. Shards are
+//! refused unless they are every shard of one run: same gloffuse, Blender, settings and
+//! inputs, each shard once, each holding exactly the files the split gives it.
+
+use std::path::{Path, PathBuf};
+
+use super::file_costs;
+use super::verdict::{AuditReport, ShardRun};
+use crate::shard::{assign, in_order};
+use crate::{Error, Field, Hint};
+
+/// A merged report, and where each of its materials came from.
+pub struct Merged {
+    pub report: AuditReport,
+    /// Per material, in the merged order: the shard (from 0) and the material's index in
+    /// that shard's report (which names its picture there).
+    pub sources: Vec<(usize, usize)>,
+    /// The shards' paths, in shard order.
+    pub shards: Vec<PathBuf>,
+}
+
+/// A shard's report.json: the path itself, or `report.json` inside a `--report` folder.
+pub fn report_json(path: &Path) -> PathBuf {
+    if path.is_dir() {
+        path.join("report.json")
+    } else {
+        path.to_path_buf()
+    }
+}
+
+/// Reads the audit report at `path` (a report.json, or the folder holding one).
+pub fn read_report(path: &Path) -> Result<AuditReport, Error> {
+    let json = report_json(path);
+    let text = std::fs::read_to_string(&json).map_err(|source| Error::Read {
+        path: json.clone(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| {
+        Error::input(
+            Field::ShardReport,
+            json.display(),
+            Hint::new(
+                format!("an audit report of a shard ({{}} K/N): {e}"),
+                [Field::Shard],
+            ),
+        )
+    })
+}
+
+/// Merges every shard of one run, given in any order.
+pub fn merge(shards: Vec<(PathBuf, AuditReport)>) -> Result<Merged, Error> {
+    let ordered = in_order(
+        shards
+            .into_iter()
+            .map(|(path, r)| (path, r.shard.as_ref().map(|s| s.shard), r))
+            .collect(),
+    )?;
+    let (first_path, first) = &ordered[0];
+    for (path, r) in &ordered[1..] {
+        if let Some(what) = difference(first, r) {
+            return Err(Error::input(
+                Field::ShardReport,
+                path.display(),
+                format!(
+                    "a shard of the same run as {}: {what}",
+                    first_path.display()
+                ),
+            ));
+        }
+    }
+    let run = first.shard.clone().expect("in_order checked every shard");
+    let materials: Vec<usize> = run.inputs.iter().map(|i| i.materials).collect();
+    let owner = assign(&file_costs(&materials), run.shard.count);
+    for (k, (path, r)) in ordered.iter().enumerate() {
+        check_part(path, r, &run, &owner, k)?;
+    }
+    let mut report = AuditReport {
+        shard: None,
+        files: Vec::new(),
+        materials: Vec::new(),
+        ..first.clone()
+    };
+    let mut sources = Vec::new();
+    for (input, &k) in run.inputs.iter().zip(&owner) {
+        let shard = &ordered[k].1;
+        let file = shard.files.iter().find(|f| f.file == input.file);
+        report.files.extend(file.cloned());
+        for (i, m) in shard.materials.iter().enumerate() {
+            if m.file == input.file {
+                report.materials.push(m.clone());
+                sources.push((k, i));
+            }
+        }
+    }
+    report.finish();
+    Ok(Merged {
+        report,
+        sources,
+        shards: ordered.into_iter().map(|(p, _)| p).collect(),
+    })
+}
+
+/// What makes `r` a shard of another run than `first`, in words.
+fn difference(first: &AuditReport, r: &AuditReport) -> Option<String> {
+    let (a, b) = (first.shard.as_ref()?, r.shard.as_ref()?);
+    if r.gloffuse_version != first.gloffuse_version {
+        return Some(format!(
+            "it was made by gloffuse {}, the other by {}",
+            r.gloffuse_version, first.gloffuse_version
+        ));
+    }
+    if r.blender_version != first.blender_version {
+        return Some(format!(
+            "it ran Blender {}, the other {}",
+            r.blender_version, first.blender_version
+        ));
+    }
+    if r.settings != first.settings {
+        return Some(format!(
+            "its settings differ ({})",
+            serde_json::to_string(&r.settings).unwrap_or_default()
+        ));
+    }
+    if b.inputs != a.inputs {
+        let shown = |s: &ShardRun| s.inputs.len();
+        return Some(format!(
+            "its input files differ ({} files, the other {}, or their names or material counts)",
+            shown(b),
+            shown(a)
+        ));
+    }
+    None
+}
+
+/// Checks that shard `k` (from 0) holds exactly the files the split gives it.
+fn check_part(
+    path: &Path,
+    r: &AuditReport,
+    run: &ShardRun,
+    owner: &[usize],
+    k: usize,
+) -> Result<(), Error> {
+    let expected: Vec<&str> = run
+        .inputs
+        .iter()
+        .zip(owner)
+        .filter(|(_, o)| **o == k)
+        .map(|(i, _)| i.file.as_str())
+        .collect();
+    let held: Vec<&str> = r.files.iter().map(|f| f.file.as_str()).collect();
+    if held == expected
+        && r.materials
+            .iter()
+            .all(|m| expected.contains(&m.file.as_str()))
+    {
+        return Ok(());
+    }
+    Err(Error::input(
+        Field::ShardReport,
+        path.display(),
+        format!(
+            "shard {}'s own files as the split gives them ({} files); it holds {} files, \
+             not all of them its own: was it edited, or made by another gloffuse?",
+            k + 1,
+            expected.len(),
+            held.len()
+        ),
+    ))
+}
