@@ -8,6 +8,9 @@
 #   Chromium — Debian's `chromium`, to load and screenshot the HTML report
 #   Mesa's software OpenGL (`libegl1`, `libgl1-mesa-dri`) — EEVEE renders headless with it
 #   ruff — PyPI's, to lint the Blender-side Python and the bundled scripts (tests/python_lint.rs)
+#   openjd-cli — PyPI's, to validate and run the farm's job template (tests/farm_e2e.rs)
+#   Slurm — Debian's slurm-wlm and munge: a one-node cluster on this machine for the farm
+#     test, started here (scripts/slurm/local-cluster.sh) and stopped when the tests end
 # Idempotent: a second run reuses what the first installed. Sourcing it defines the steps
 # as functions without running them (tests/test_script.rs runs them one by one).
 set -euo pipefail
@@ -133,12 +136,16 @@ share_bpy_45() {
     fi
 }
 
-provision_ruff() { # pip requirement
-    local dir="$cache/ruff"
-    if [ ! -x "$dir/bin/ruff" ] || ! "$dir/bin/ruff" --version >/dev/null 2>&1; then
-        venv_install "$dir" "$1"
+provision_tool() { # name, program in its venv's bin, pip requirement
+    local dir="$cache/$1"
+    if [ ! -x "$dir/bin/$2" ] || ! "$dir/bin/$2" --version >/dev/null 2>&1; then
+        venv_install "$dir" "$3"
     fi
 }
+
+# The one-node Slurm cluster's state (its own munged, slurm.conf, spool): a short path, as
+# munge's socket path is limited.
+slurm_state() { echo "$cache/slurm"; }
 
 main() {
     cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -148,17 +155,24 @@ main() {
     find_python
     share_bpy_45 & bpy45=$!
     provision_bpy bpy-5.0 'bpy>=5.0,<5.1' & bpy50=$!
-    provision_ruff 'ruff>=0.17,<0.18' & ruff=$!
-    wait "$bpy45"; wait "$bpy50"; wait "$ruff"
+    provision_tool ruff ruff 'ruff>=0.17,<0.18' & ruff=$!
+    provision_tool openjd openjd 'openjd-cli>=0.8,<0.9' & openjd=$!
+    wait "$bpy45"; wait "$bpy50"; wait "$ruff"; wait "$openjd"
+    trap 'bash scripts/slurm/local-cluster.sh stop "$(slurm_state)"' EXIT
+    bash scripts/slurm/local-cluster.sh start "$(slurm_state)" >/dev/null
 
     export GLOFFUSE_TEST_BLENDER_34="$blender34"
     export GLOFFUSE_TEST_BPY_45="$cache/bpy-4.5/bin/python"
     export GLOFFUSE_TEST_BPY_50="$cache/bpy-5.0/bin/python"
     export GLOFFUSE_TEST_RUFF="$cache/ruff/bin/ruff"
+    export GLOFFUSE_TEST_OPENJD="$cache/openjd/bin/openjd"
+    export GLOFFUSE_TEST_SLURM_CONF="$(slurm_state)/slurm.conf"
     "$GLOFFUSE_TEST_BLENDER_34" -b --factory-startup -noaudio --version 2>/dev/null | head -1
     "$GLOFFUSE_TEST_BPY_45" -c "import bpy; print('bpy', bpy.app.version_string)"
     "$GLOFFUSE_TEST_BPY_50" -c "import bpy; print('bpy', bpy.app.version_string)"
     "$GLOFFUSE_TEST_RUFF" --version
+    "$GLOFFUSE_TEST_OPENJD" --version 2>&1 | head -1
+    SLURM_CONF="$GLOFFUSE_TEST_SLURM_CONF" sinfo --version
 
     cargo test --locked "$@"
 }
