@@ -398,3 +398,23 @@ pub fn bench_audit(r: &gloffuse::bench::audit::AuditBenchResult) -> String {
     ));
     s
 }
+
+pub fn bench_shards(r: &gloffuse::bench::shards::ShardBenchResult) -> String {
+    format!(
+        "sharded audit in Blender {} ({} px, {} spp): {} files of {} materials\n\
+         \n  one run:            {:>7.1} s\n  {} shards at once:   {:>7.1} s   {:.2}× faster\n\
+         \ncost model: a file takes {:.2} s to start (Blender and the twins' tables) plus \
+         {:.3} s per material\n",
+        r.blender_version,
+        r.cell,
+        r.samples,
+        r.files,
+        r.materials_per_file,
+        r.one_run_seconds,
+        r.shards,
+        r.sharded_seconds,
+        r.speedup,
+        r.start_seconds,
+        r.per_material_seconds
+    )
+}

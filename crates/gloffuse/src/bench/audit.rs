@@ -123,7 +123,7 @@ fn timed(
 }
 
 /// Saves a library of `count` materials numbered from `first` at `path`.
-fn library(
+pub(crate) fn library(
     blender: &Blender,
     b: &AuditBenchOptions,
     path: &Path,

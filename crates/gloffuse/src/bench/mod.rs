@@ -2,6 +2,7 @@
 //! per sphere, the measurement behind "one Blender process renders a whole sweep".
 
 pub mod audit;
+pub mod shards;
 
 use serde::Serialize;
 use std::time::Instant;
