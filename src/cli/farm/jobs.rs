@@ -99,11 +99,20 @@ pub fn slurm(job: &FarmJob, sbatch_args: &[String]) -> SlurmJob {
     let command = |args: Vec<String>| {
         std::iter::once(job.program.clone())
             .chain(args)
-            .map(|a| {
-                a.split(K)
-                    .map(|piece| shell_quote(piece.as_ref()))
+            .map(|a| match a.contains(K) {
+                // An empty piece beside "$k" needs no quotes; an empty argument does ('').
+                true => a
+                    .split(K)
+                    .map(|p| {
+                        if p.is_empty() {
+                            String::new()
+                        } else {
+                            shell_quote(p.as_ref())
+                        }
+                    })
                     .collect::<Vec<_>>()
-                    .join("\"$k\"")
+                    .join("\"$k\""),
+                false => shell_quote(a.as_ref()),
             })
             .collect::<Vec<_>>()
             .join(" \\\n    ")
