@@ -130,16 +130,7 @@ fn three_shards_merge_into_the_report_of_one_run() {
     let out = tempfile::tempdir().unwrap();
     let o = |name: &str| out.path().join(name);
     let s = |p: PathBuf| p.display().to_string();
-    let (code, err) = audit(
-        blender,
-        lib,
-        &[
-            &RENDER[..],
-            &["--report", &s(o("all")), "--junit", &s(o("all.xml"))],
-        ]
-        .concat(),
-    );
-    assert_eq!(code, 1, "the library has failing materials: {err}");
+    let one_run = unsharded_run().unwrap();
     let mut held = Vec::new();
     for k in 1..=3 {
         let (code, err) = audit(
@@ -184,7 +175,7 @@ fn three_shards_merge_into_the_report_of_one_run() {
         "{}",
         String::from_utf8_lossy(&merged.stderr)
     );
-    let all = comparable(json(&o("all/report.json")));
+    let all = comparable(json(&one_run.join("report/report.json")));
     let m = comparable(json(&o("merged/report.json")));
     assert_same(&all, &m, 1e-6, "report");
     assert_eq!(json(&o("merged.json")), json(&o("merged/report.json")));
@@ -202,24 +193,24 @@ fn three_shards_merge_into_the_report_of_one_run() {
     }
     let read = |p: PathBuf| std::fs::read_to_string(p).unwrap();
     assert_eq!(
-        without_rerun(&read(o("all.xml"))),
+        without_rerun(&read(one_run.join("junit.xml"))),
         without_rerun(&read(o("merged.xml")))
     );
     assert_eq!(
-        without_rerun(&read(o("all/report.html"))),
+        without_rerun(&read(one_run.join("report/report.html"))),
         without_rerun(&read(o("merged/report.html")))
     );
-    let pictures = |d: &str| {
-        let mut names: Vec<String> = std::fs::read_dir(o(d).join("materials"))
+    let pictures = |d: &Path| {
+        let mut names: Vec<String> = std::fs::read_dir(d.join("materials"))
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
         names.sort();
         names
     };
-    assert_eq!(pictures("all"), pictures("merged"));
-    assert!(!pictures("merged").is_empty());
-    refusals(out.path());
+    assert_eq!(pictures(&one_run.join("report")), pictures(&o("merged")));
+    assert!(!pictures(&o("merged")).is_empty());
+    refusals(out.path(), &one_run.join("report"));
 }
 
 /// `report merge` of `shards`: its exit code and stderr.
@@ -236,7 +227,7 @@ fn merge(shards: &[PathBuf]) -> (i32, String) {
 }
 
 /// A missing shard, a shard twice, a shard of another run: each refused with exit 2, by name.
-fn refusals(dir: &Path) {
+fn refusals(dir: &Path, unsharded: &Path) {
     let s = |k: usize| dir.join(format!("s{k}"));
     let (code, err) = merge(&[s(1), s(3)]);
     assert_eq!(code, 2);
@@ -265,12 +256,38 @@ fn refusals(dir: &Path) {
     });
     let (code, err) = merge(&[s(1), s(2), other_files]);
     assert!(code == 2 && err.contains("input files differ"), "{err}");
-    let unsharded = merge(&[dir.join("all")]);
+    let unsharded = merge(&[unsharded.to_path_buf()]);
     assert!(
         unsharded.0 == 2 && unsharded.1.contains("--shard"),
         "{}",
         unsharded.1
     );
+}
+
+/// The library's audit rendered in one run: a folder with `report/` (`--report`) and
+/// `junit.xml`, made once for the tests that compare shards with it.
+fn unsharded_run() -> Option<&'static PathBuf> {
+    static RUN: OnceLock<Option<PathBuf>> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let (blender, lib) = library()?;
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("farm-unsharded");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let (report, junit) = (dir.join("report"), dir.join("junit.xml"));
+        let (code, err) = audit(
+            blender,
+            lib,
+            &[
+                &RENDER[..],
+                &["--report", report.to_str().unwrap()],
+                &["--junit", junit.to_str().unwrap()],
+            ]
+            .concat(),
+        );
+        assert_eq!(code, 1, "the library has failing materials: {err}");
+        Some(dir)
+    })
+    .as_ref()
 }
 
 /// The rules-only audit of the library, unsharded: what the farms' merged reports must equal.
@@ -312,7 +329,7 @@ fn slurm_runs_the_shards_then_the_merge() {
     let Some((blender, lib)) = library() else {
         return;
     };
-    let expected = local_rules_report().unwrap();
+    let expected = comparable(json(&unsharded_run().unwrap().join("report/report.json")));
     let dir = tempfile::tempdir().unwrap();
     let job = dir.path().join("job dir");
     let out = gloffuse()
@@ -321,7 +338,9 @@ fn slurm_runs_the_shards_then_the_merge() {
         .arg(lib)
         .args(["--shards", "3", "--submit", "--json", "--out"])
         .arg(&job)
-        .args(["--", "--no-render", "--no-provision", "--blender"])
+        .arg("--")
+        .args(RENDER)
+        .args(["--no-provision", "--blender"])
         .arg(blender)
         .output()
         .unwrap();
@@ -339,13 +358,17 @@ fn slurm_runs_the_shards_then_the_merge() {
         assert!(job.join(format!("shard-{k}/report.json")).is_file());
         assert!(job.join(format!("logs/shard-{k}.log")).is_file());
     }
+    // Rendered: as close to the local run as two runs are (see assert_same).
     assert_same(
-        expected,
+        &expected,
         &comparable(json(&job.join("merged.json"))),
-        0.0,
+        1e-6,
         "slurm",
     );
     assert!(job.join("merged/report.html").is_file() && job.join("merged.xml").is_file());
+    let count = |d: PathBuf| std::fs::read_dir(d).unwrap().count();
+    let local = unsharded_run().unwrap().join("report/materials");
+    assert_eq!(count(job.join("merged/materials")), count(local));
 }
 
 /// Polls `scontrol show job ID` until the job ends: its JobState and ExitCode.
