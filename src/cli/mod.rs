@@ -25,7 +25,7 @@ mod text;
 
 use clap::Parser;
 use std::io::{self, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicI32, Ordering};
@@ -368,9 +368,17 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     if let Some(dir) = &m.report {
         let mut folder = ReportDir::create(dir)?;
         let mut unpictured = std::collections::BTreeSet::new();
+        // Each shard's folder: the one holding its report.json.
+        let folders: Vec<PathBuf> = (merged.shards.iter())
+            .map(|s| {
+                report_json(s)
+                    .parent()
+                    .unwrap_or(Path::new("."))
+                    .to_path_buf()
+            })
+            .collect();
         for (&(k, i), material) in merged.sources.iter().zip(&report.materials) {
-            let json = report_json(&merged.shards[k]);
-            let picture = picture_of(json.parent().unwrap_or(Path::new(".")), i);
+            let picture = picture_of(&folders[k], i);
             let found = picture.is_file();
             if !found && material.mean.is_some() {
                 unpictured.insert(k + 1);

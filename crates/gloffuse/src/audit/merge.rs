@@ -3,10 +3,11 @@
 //! refused unless they are every shard of one run: same gloffuse, Blender, settings and
 //! inputs, each shard once, each holding exactly the files the split gives it.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::file_costs;
-use super::verdict::{AuditReport, ShardRun};
+use super::verdict::{AuditReport, AuditedFile, ShardRun};
 use crate::shard::{assign, in_order};
 use crate::{Error, Field, Hint};
 
@@ -81,16 +82,33 @@ pub fn merge(shards: Vec<(PathBuf, AuditReport)>) -> Result<Merged, Error> {
         materials: Vec::new(),
         ..first.clone()
     };
+    // Each shard's files and materials by file name, found once rather than searched for
+    // every input.
+    let by_file: Vec<HashMap<&str, (&AuditedFile, Vec<usize>)>> = ordered
+        .iter()
+        .map(|(_, r)| {
+            let mut files: HashMap<&str, (&AuditedFile, Vec<usize>)> = r
+                .files
+                .iter()
+                .map(|f| (f.file.as_str(), (f, Vec::new())))
+                .collect();
+            for (i, m) in r.materials.iter().enumerate() {
+                if let Some((_, indices)) = files.get_mut(m.file.as_str()) {
+                    indices.push(i);
+                }
+            }
+            files
+        })
+        .collect();
     let mut sources = Vec::new();
     for (input, &k) in run.inputs.iter().zip(&owner) {
-        let shard = &ordered[k].1;
-        let file = shard.files.iter().find(|f| f.file == input.file);
-        report.files.extend(file.cloned());
-        for (i, m) in shard.materials.iter().enumerate() {
-            if m.file == input.file {
-                report.materials.push(m.clone());
-                sources.push((k, i));
-            }
+        let Some((file, indices)) = by_file[k].get(input.file.as_str()) else {
+            continue;
+        };
+        report.files.push((*file).clone());
+        for &i in indices {
+            report.materials.push(ordered[k].1.materials[i].clone());
+            sources.push((k, i));
         }
     }
     report.finish();
@@ -103,7 +121,7 @@ pub fn merge(shards: Vec<(PathBuf, AuditReport)>) -> Result<Merged, Error> {
 
 /// What makes `r` a shard of another run than `first`, in words.
 fn difference(first: &AuditReport, r: &AuditReport) -> Option<String> {
-    let (a, b) = (first.shard.as_ref()?, r.shard.as_ref()?);
+    let (a, b) = (&first.shard.as_ref()?.inputs, &r.shard.as_ref()?.inputs);
     if r.gloffuse_version != first.gloffuse_version {
         return Some(format!(
             "it was made by gloffuse {}, the other by {}",
@@ -122,12 +140,11 @@ fn difference(first: &AuditReport, r: &AuditReport) -> Option<String> {
             serde_json::to_string(&r.settings).unwrap_or_default()
         ));
     }
-    if b.inputs != a.inputs {
-        let shown = |s: &ShardRun| s.inputs.len();
+    if b != a {
         return Some(format!(
             "its input files differ ({} files, the other {}, or their names or material counts)",
-            shown(b),
-            shown(a)
+            b.len(),
+            a.len()
         ));
     }
     None
