@@ -110,16 +110,22 @@ fn timed(
     files: &[PathBuf],
     render: bool,
 ) -> Result<(f64, AuditReport), Error> {
-    let options = AuditOptions {
+    let options = options(b, files, render);
+    let start = Instant::now();
+    let report = audit_with(blender, &options, &Quiet, &mut |_| Ok(()))?;
+    Ok((start.elapsed().as_secs_f64(), report))
+}
+
+/// The benchmark's audit of `files`: its render settings and Blender, rendered or the rules
+/// alone.
+pub(crate) fn options(b: &AuditBenchOptions, files: &[PathBuf], render: bool) -> AuditOptions {
+    AuditOptions {
         paths: files.to_vec(),
         render,
         settings: b.render,
         blender: b.blender.clone(),
         ..AuditOptions::default()
-    };
-    let start = Instant::now();
-    let report = audit_with(blender, &options, &Quiet, &mut |_| Ok(()))?;
-    Ok((start.elapsed().as_secs_f64(), report))
+    }
 }
 
 /// Saves a library of `count` materials numbered from `first` at `path`.

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::audit::{AuditBenchOptions, library};
+use super::audit::{AuditBenchOptions, library, options};
 use crate::Error;
 use crate::audit::{AuditOptions, audit_with};
 use crate::blender::{Blender, runs};
@@ -47,41 +47,33 @@ pub fn bench_shards(
     let dir = runs::new_run_dir("bench-shards")?;
     let files = 4 * shards.max(1);
     progress.begin("building and auditing the sharded library", 3);
+    let folder = dir.join("library");
+    std::fs::create_dir_all(&folder).map_err(|e| Error::Write {
+        path: folder.clone(),
+        message: e.to_string(),
+    })?;
     let library_files = (0..files)
         .map(|i| {
-            let path = dir.join(format!("library/file-{i:03}.blend"));
-            std::fs::create_dir_all(path.parent().expect("in the library folder")).map_err(
-                |e| Error::Write {
-                    path: path.clone(),
-                    message: e.to_string(),
-                },
-            )?;
-            library(
-                &blender,
-                b,
-                &path,
-                i * MATERIALS_PER_FILE,
-                MATERIALS_PER_FILE,
-            )
+            let path = folder.join(format!("file-{i:03}.blend"));
+            let first = i * MATERIALS_PER_FILE;
+            library(&blender, b, &path, first, MATERIALS_PER_FILE)
         })
         .collect::<Result<Vec<PathBuf>, Error>>()?;
     let single = library(&blender, b, &dir.join("single.blend"), 0, 1)?;
-    let options = |paths: Vec<PathBuf>, shard: Option<Shard>| AuditOptions {
-        paths,
-        settings: b.render,
-        blender: b.blender.clone(),
+    let options = |paths: &[PathBuf], shard: Option<Shard>| AuditOptions {
         shard,
-        ..AuditOptions::default()
+        ..options(b, paths, true)
     };
-    let one_file = timed(|| run(&blender, &options(vec![single.clone()], None)))?;
-    let one_run_seconds = timed(|| run(&blender, &options(library_files.clone(), None)))?;
+    let one_file = timed(|| run(&blender, &options(&[single], None)))?;
+    progress.step();
+    let one_run_seconds = timed(|| run(&blender, &options(&library_files, None)))?;
     progress.step();
     let sharded_seconds = timed(|| {
         std::thread::scope(|scope| {
             let runs: Vec<_> = (1..=shards)
                 .map(|index| {
                     let o = options(
-                        library_files.clone(),
+                        &library_files,
                         Some(Shard {
                             index,
                             count: shards,
