@@ -26,12 +26,18 @@ pub fn multiscatter_tint(f: f64, e_avg: f64) -> f64 {
     f * e_avg / (1.0 - f * (1.0 - e_avg))
 }
 
-/// The coat albedo from its parts: `E_F (1 + Fms (1 − E)/E)`.
+/// The coat albedo from its parts: `E_F · coat_gain`.
 pub fn coat_albedo(e_fresnel: f64, e: f64, f_avg: f64, e_avg: f64) -> f64 {
+    e_fresnel * coat_gain(e, f_avg, e_avg)
+}
+
+/// `A / E_F = 1 + Fms (1 − E)/E`: what a single-scattering lobe with the Fresnel at its
+/// microfacets is multiplied by to reflect A (1 where E is 0).
+pub fn coat_gain(e: f64, f_avg: f64, e_avg: f64) -> f64 {
     if e <= 0.0 {
-        return e_fresnel;
+        return 1.0;
     }
-    e_fresnel * (1.0 + multiscatter_tint(f_avg, e_avg) * (1.0 - e) / e)
+    1.0 + multiscatter_tint(f_avg, e_avg) * (1.0 - e) / e
 }
 
 /// `F_avg(η) = 2 ∫₀¹ F(μ, η) μ dμ`. F is smooth in μ for η ≥ 1 but turns steeply towards 1 at
@@ -84,6 +90,8 @@ pub struct CoatGrid {
     pub ior: [f64; SLICES],
     /// `a[(k * mu.len() + i) * roughness.len() + j] = A(μ_i, r_j, η_k)`: one slice per index.
     pub a: Vec<f64>,
+    /// `A / E_F` ([`coat_gain`]) in the layout of `a`.
+    pub gain: Vec<f64>,
     /// `e[i * roughness.len() + j] = E(μ_i, r_j)`.
     pub e: Vec<f64>,
 }
@@ -95,6 +103,10 @@ impl CoatGrid {
 
     pub fn e(&self, i: usize, j: usize) -> f64 {
         self.e[i * self.roughness.len() + j]
+    }
+
+    pub fn gain(&self, k: usize, i: usize, j: usize) -> f64 {
+        self.gain[(k * self.mu.len() + i) * self.roughness.len() + j]
     }
 }
 
@@ -151,6 +163,13 @@ impl<'a> Coat<'a> {
 /// One more moment than slices: the white albedo E rides along with the Fresnel ones.
 const MOMENTS: usize = SLICES + 1;
 
+/// One (μ, r) entry of the coat grid: A and its gain per slice, and E.
+struct CoatEntry {
+    a: [f64; SLICES],
+    gain: [f64; SLICES],
+    e: f64,
+}
+
 impl AlbedoIntegrator {
     /// `E_F(μ) = ∫ f F(ωo·h, η) cosθi dωi` and `E(μ)` in one pass.
     pub fn fresnel_albedo(&self, glossy: &Glossy, mu: f64, eta: f64) -> (f64, f64) {
@@ -164,9 +183,9 @@ impl AlbedoIntegrator {
         Coat::new(self, *glossy, eta).albedo(mu)
     }
 
-    /// The coat table at the [`slice_iors`]: each (μ, r) entry takes one pass over the half
-    /// vectors for every slice and E at once. Columns (one per roughness) run in parallel;
-    /// `progress` steps once per column.
+    /// The coat table (A, its gain, E) at the [`slice_iors`]: each (μ, r) entry takes one
+    /// pass over the half vectors for every slice and E at once. Columns (one per roughness)
+    /// run in parallel; `progress` steps once per column.
     pub fn coat_grid(
         &self,
         distribution: Distribution,
@@ -177,7 +196,7 @@ impl AlbedoIntegrator {
     ) -> CoatGrid {
         let ior = slice_iors();
         let f_avg = ior.map(fresnel_average);
-        let columns: Vec<Vec<[f64; MOMENTS]>> = roughness
+        let columns: Vec<Vec<CoatEntry>> = roughness
             .par_iter()
             .map(|&r| {
                 let glossy = Glossy::new(distribution, masking, r);
@@ -195,13 +214,12 @@ impl AlbedoIntegrator {
                             })
                         });
                         let e = moments[SLICES];
-                        std::array::from_fn(|k| {
-                            if k < SLICES {
-                                coat_albedo(moments[k], e, f_avg[k], e_avg)
-                            } else {
-                                e
-                            }
-                        })
+                        let gain = std::array::from_fn(|k| coat_gain(e, f_avg[k], e_avg));
+                        CoatEntry {
+                            a: std::array::from_fn(|k| moments[k] * gain[k]),
+                            gain,
+                            e,
+                        }
                     })
                     .collect();
                 progress.step();
@@ -214,13 +232,15 @@ impl AlbedoIntegrator {
             mu: mu.to_vec(),
             ior,
             a: vec![0.0; SLICES * height * width],
+            gain: vec![0.0; SLICES * height * width],
             e: vec![0.0; height * width],
         };
         for (j, column) in columns.iter().enumerate() {
             for (i, entry) in column.iter().enumerate() {
-                grid.e[i * width + j] = entry[SLICES];
-                for (k, &a) in entry[..SLICES].iter().enumerate() {
-                    grid.a[(k * height + i) * width + j] = a;
+                grid.e[i * width + j] = entry.e;
+                for k in 0..SLICES {
+                    grid.a[(k * height + i) * width + j] = entry.a[k];
+                    grid.gain[(k * height + i) * width + j] = entry.gain[k];
                 }
             }
         }
@@ -268,6 +288,13 @@ mod tests {
                 for (j, &r) in rs.iter().enumerate() {
                     let g = Glossy::new(Distribution::Ggx, Masking::HeightCorrelated, r);
                     assert!((grid.a(k, i, j) - q.coat(&g, mu, eta)).abs() < 1e-15);
+                    let (e_f, _) = q.fresnel_albedo(&g, mu, eta);
+                    if e_f > 0.0 {
+                        let ratio = grid.a(k, i, j) / e_f;
+                        assert!((grid.gain(k, i, j) - ratio).abs() < 1e-12 * ratio);
+                    } else {
+                        assert_eq!(grid.gain(k, i, j), 1.0);
+                    }
                     assert_eq!(grid.e(i, j), q.directional_albedo(&g, mu));
                 }
             }

@@ -98,6 +98,11 @@ pub struct CoatTable {
     pub z_max: f64,
     /// Image rows, bottom first: `values[i * size * slices + k * size + j]`.
     pub values: Vec<f32>,
+    /// Beckmann only: `A / E_F` in the layout of `values`, the gain of the single-scattering
+    /// Metallic BSDF coat (Blender 5.0+: its Physical Conductor Fresnel with index η and no
+    /// extinction is the dielectric one; Cycles compensates only GGX).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gain: Option<Vec<f32>>,
 }
 
 impl CoatTable {
@@ -106,12 +111,18 @@ impl CoatTable {
         let axis = Roughness::grid(size);
         let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
         let grid = integrator.coat_grid(distribution, masking, &axis, &mus, &Quiet);
-        let mut values = Vec::with_capacity(size * size * coat::SLICES);
-        for i in 0..size {
-            for k in 0..coat::SLICES {
-                values.extend((0..size).map(|j| grid.a(k, i, j) as f32));
+        let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
+            let mut values = Vec::with_capacity(size * size * coat::SLICES);
+            for i in 0..size {
+                for k in 0..coat::SLICES {
+                    values.extend((0..size).map(|j| at(k, i, j) as f32));
+                }
             }
-        }
+            values
+        };
+        let values = packed(&|k, i, j| grid.a(k, i, j));
+        let gain =
+            (distribution == Distribution::Beckmann).then(|| packed(&|k, i, j| grid.gain(k, i, j)));
         CoatTable {
             size,
             slices: coat::SLICES,
@@ -119,6 +130,7 @@ impl CoatTable {
             ior_max: coat::IOR_MAX,
             z_max: coat::slice_coordinate(coat::IOR_MAX),
             values,
+            gain,
         }
     }
 }
@@ -184,6 +196,9 @@ pub struct FamilySpec {
     pub coat_image: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coat_table: Option<CoatTable>,
+    /// Name of the packed float image holding `coat_table.gain` (layered Beckmann only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coat_gain_image: Option<String>,
 }
 
 /// One distribution's node groups, as the Python side builds them. The script picks the
@@ -452,6 +467,8 @@ fn group_spec(
                     coat_image: layered
                         .then(|| format!("Gloffuse coat A ({}, {})", d.label(), masking)),
                     coat_table: layered.then(|| CoatTable::compute(d, *masking, COAT_TABLE_SIZE)),
+                    coat_gain_image: (layered && d == Distribution::Beckmann)
+                        .then(|| format!("Gloffuse coat gain ({}, {})", d.label(), masking)),
                 })
             })
             .collect(),
