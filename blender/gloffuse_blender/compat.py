@@ -192,6 +192,40 @@ def glossy_node(nodes, distribution):
     return node
 
 
+def principled_coat_node(nodes):
+    """A Principled BSDF that is its dielectric specular layer alone (Base
+    Color black, Metallic 0, Multiscatter GGX), or None before 4.0. From 4.0
+    Principled applies the exact dielectric Fresnel at each microfacet, takes
+    its index from IOR (Specular IOR Level 0.5 keeps it), tints F0 by Specular
+    Tint and compensates multiple scattering; 3.x's specular takes F0 from
+    Specular (at most 0.08) and ignores Specular Tint over a black base."""
+    if tuple(bpy.app.version[:2]) < (4, 0):
+        return None
+    node = nodes.new("ShaderNodeBsdfPrincipled")
+    node.distribution = "MULTI_GGX"
+    node.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    node.inputs["Metallic"].default_value = 0.0
+    node.inputs["Emission Strength"].default_value = 0.0
+    compat_principled_dielectric(node, 1.5)
+    return node
+
+
+def metallic_coat_node(nodes, distribution):
+    """A Metallic BSDF of `distribution` in Physical Conductor mode with
+    Extinction 0 and no thin film (its IOR input is the coat's index), or None
+    before 5.0. Cycles 5.0 made that Fresnel the exact polarised conductor one,
+    which with no extinction is the dielectric Fresnel; 4.3-4.5 evaluate an
+    approximate form, 49 % high at IOR 1.5 (docs/PHYSICS.md §13)."""
+    if tuple(bpy.app.version[:2]) < (5, 0):
+        return None
+    node = nodes.new("ShaderNodeBsdfMetallic")
+    node.distribution = distribution
+    node.fresnel_type = "PHYSICAL_CONDUCTOR"
+    node.inputs["Extinction"].default_value = (0.0, 0.0, 0.0)
+    node.inputs["Thin Film Thickness"].default_value = 0.0
+    return node
+
+
 def find_socket(sockets, identifier, name=None, socket_type=None):
     """The socket with this identifier; else (an identifier renamed in a
     newer Blender) the one enabled socket called `name` of type `socket_type`

@@ -98,6 +98,7 @@ def resolve_params(document):
                 "shader_group": spec["layered_group"],
                 "image": family.get("image"), "table": family.get("table"),
                 "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
+                "coat_gain_image": family.get("coat_gain_image"),
             }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
@@ -157,6 +158,10 @@ def validate_params(params):
             for key in ("image", "coat_image"):
                 _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
             coat = layered.get("coat_table")
+            if layered.get("coat_gain_image") is not None:
+                _name(layered["coat_gain_image"], "%s.layered.coat_gain_image" % where, limit)
+                if not isinstance(coat, dict) or "gain" not in coat:
+                    raise ValueError("%s.layered.coat_gain_image needs coat_table.gain" % where)
             if not isinstance(coat, dict) or not all(
                     isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
                 raise ValueError("%s.layered.coat_table needs integer size and slices of at "

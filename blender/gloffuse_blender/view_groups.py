@@ -210,16 +210,24 @@ def glossy_plus_diffuse(tree, spec, group_in, glossy_color, diffuse_color, x, la
     colour glossy_color, plus a Diffuse BSDF of colour diffuse_color (the group's
     Normal), into the group's BSDF output; nodes from column x on, labelled
     (glossy, diffuse, add)."""
-    nodes, links = tree.nodes, tree.links
     glossy_label, diffuse_label, add_label = labels
-    glossy = glossy_node(nodes, spec["distribution"])
+    glossy = glossy_node(tree.nodes, spec["distribution"])
     glossy.name = "Glossy BSDF"
     glossy.label = short_label(glossy_label)
     glossy.width = NODE_WIDTH
     glossy.location = (x, 200.0)
-    links.new(glossy_color, glossy.inputs["Color"])
-    links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
-    links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
+    tree.links.new(glossy_color, glossy.inputs["Color"])
+    tree.links.new(group_in.outputs["Roughness"], glossy.inputs["Roughness"])
+    tree.links.new(group_in.outputs["Normal"], glossy.inputs["Normal"])
+    shader_plus_diffuse(tree, group_in, glossy.outputs[0], diffuse_color, x,
+                        (diffuse_label, add_label))
+
+
+def shader_plus_diffuse(tree, group_in, shader, diffuse_color, x, labels):
+    """`shader` plus a Diffuse BSDF of colour diffuse_color (the group's Normal)
+    into the group's BSDF output; nodes from column x on, labelled (diffuse, add)."""
+    nodes, links = tree.nodes, tree.links
+    diffuse_label, add_label = labels
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.name = "Diffuse BSDF"
     diffuse.label = diffuse_label
@@ -230,7 +238,7 @@ def glossy_plus_diffuse(tree, spec, group_in, glossy_color, diffuse_color, x, la
     add = nodes.new("ShaderNodeAddShader")
     add.name = add_label
     add.location = (x + COLUMN_STEP, 0.0)
-    links.new(glossy.outputs[0], add.inputs[0])
+    links.new(shader, add.inputs[0])
     links.new(diffuse.outputs[0], add.inputs[1])
     group_out = nodes.new("NodeGroupOutput")
     group_out.location = (x + 2 * COLUMN_STEP, 0.0)

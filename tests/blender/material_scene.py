@@ -11,10 +11,22 @@
 # pixel of every render is shaded at the same point with the same random
 # numbers: the ratio of two renders is the ratio of their BSDF weights there.
 #
+# The scene section may also ask for a lit scene instead of the furnace
+# ("lighting": "sky_sun": a sky graded from horizon to zenith plus a sun, as
+# {"sky": [horizon, zenith], "sun": {"strength", "angle", "elevation",
+# "azimuth"}}) and for a real Bump node instead of the tilted normal ("bump":
+# {"strength", "distance"}).
+#
 # Variants ("kind"):
 #   glossy      a plain Glossy BSDF of "distribution" (MULTI_GGX included)
 #   group       the shader group "group" (Color, Roughness, Normal inputs)
 #   correction  the correction group "group" feeding a plain Glossy of "distribution"
+#   layered     the layered group "group" (Base Color = "color", Roughness,
+#               "ior", "tint" as Specular Tint, Normal)
+#   principled  a Principled BSDF with the same inputs ("distribution",
+#               Multiscatter GGX by default)
+#   metallic    a Metallic BSDF of "distribution" in Physical Conductor mode,
+#               IOR "ior" on every channel, Extinction 0
 #   probe       an emission of 0.5 + 0.5 v for v = the view direction ("incoming"),
 #               the true normal, the tilted normal, or (r, 0, 0) ("roughness")
 # Each render is written to output_dir/NAME.exr; one GLOFFUSE_RESULT line lists them.
@@ -26,7 +38,12 @@ import sys
 
 import bpy
 
-from gloffuse_blender.compat import blender_version_string, compat_camera_rays_only, compat_node_tree
+from gloffuse_blender.compat import (
+    blender_version_string,
+    compat_camera_rays_only,
+    compat_node_tree,
+    compat_principled_dielectric,
+)
 from gloffuse_blender.furnace import furnace_render_settings, furnace_world, render_sweep
 from gloffuse_blender.groups import build_all
 from gloffuse_blender.meshes import sphere_mesh
@@ -58,6 +75,13 @@ def shading_inputs(tree, scene):
     noise = nodes.new("ShaderNodeTexNoise")
     noise.inputs["Scale"].default_value = scene["noise_scale"]
     links.new(coords.outputs["Object"], noise.inputs["Vector"])
+    bump_settings = scene.get("bump")
+    if bump_settings:
+        bump = nodes.new("ShaderNodeBump")
+        bump.inputs["Strength"].default_value = bump_settings["strength"]
+        bump.inputs["Distance"].default_value = bump_settings["distance"]
+        links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        return ramp.outputs["Result"], bump.outputs["Normal"]
     # A procedural normal map: the smooth normal tilted by the noise colour
     # (2 c - 1, times "tilt"), so some normals lean far away from the viewer.
     # (Not a Bump node: Blender 3.0-3.5's Bump node raises its own output, and
@@ -127,6 +151,30 @@ def variant_material(scene, variant):
         links.new(roughness, node.inputs["Roughness"])
         links.new(normal, node.inputs["Normal"])
         shader = node.outputs["BSDF"]
+    elif kind in ("layered", "principled"):
+        if kind == "layered":
+            node = nodes.new("ShaderNodeGroup")
+            node.node_tree = bpy.data.node_groups[variant["group"]]
+            node.inputs["IOR"].default_value = variant["ior"]
+            shader = node.outputs["BSDF"]
+        else:
+            node = nodes.new("ShaderNodeBsdfPrincipled")
+            node.distribution = variant.get("distribution", "MULTI_GGX")
+            compat_principled_dielectric(node, variant["ior"])
+            shader = node.outputs["BSDF"]
+        node.inputs["Base Color"].default_value = color
+        node.inputs["Specular Tint"].default_value = tuple(variant.get("tint", (1.0,) * 3)) + (1.0,)
+        links.new(roughness, node.inputs["Roughness"])
+        links.new(normal, node.inputs["Normal"])
+    elif kind == "metallic":
+        node = nodes.new("ShaderNodeBsdfMetallic")
+        node.distribution = variant["distribution"]
+        node.fresnel_type = "PHYSICAL_CONDUCTOR"
+        node.inputs["IOR"].default_value = (variant["ior"],) * 3
+        node.inputs["Extinction"].default_value = (0.0, 0.0, 0.0)
+        links.new(roughness, node.inputs["Roughness"])
+        links.new(normal, node.inputs["Normal"])
+        shader = node.outputs["BSDF"]
     elif kind == "correction":
         node = nodes.new("ShaderNodeGroup")
         node.node_tree = bpy.data.node_groups[variant["group"]]
@@ -145,14 +193,55 @@ def variant_material(scene, variant):
     return material
 
 
+def sky_world(sky):
+    """A sky graded linearly in the direction's height, from the horizon colour
+    (and below) to the zenith colour."""
+    world = bpy.data.worlds.new("Scene sky")
+    tree = compat_node_tree(world)
+    tree.nodes.clear()
+    nodes, links = tree.nodes, tree.links
+    coords = nodes.new("ShaderNodeTexCoord")
+    split = nodes.new("ShaderNodeSeparateXYZ")
+    links.new(coords.outputs["Generated"], split.inputs[0])
+    height = nodes.new("ShaderNodeMath")
+    height.operation = "MAXIMUM"
+    links.new(split.outputs["Z"], height.inputs[0])
+    height.inputs[1].default_value = 0.0
+    horizon, zenith = (tuple(c) for c in sky)
+    grade = nodes.new("ShaderNodeVectorMath")
+    grade.operation = "MULTIPLY_ADD"
+    links.new(height.outputs[0], grade.inputs[0])
+    grade.inputs[1].default_value = tuple(z - h for z, h in zip(zenith, horizon))
+    grade.inputs[2].default_value = horizon
+    background = nodes.new("ShaderNodeBackground")
+    links.new(grade.outputs["Vector"], background.inputs["Color"])
+    background.inputs["Strength"].default_value = 1.0
+    output = nodes.new("ShaderNodeOutputWorld")
+    links.new(background.outputs["Background"], output.inputs["Surface"])
+    return world
+
+
+def add_sun(render_scene, sun):
+    data = bpy.data.lights.new("Scene sun", "SUN")
+    data.energy = sun["strength"]
+    data.angle = math.radians(sun["angle"])
+    light = bpy.data.objects.new("Scene sun", data)
+    # A sun light shines down its local -Z: tilt it from the zenith, then turn it.
+    light.rotation_euler = (math.radians(90.0 - sun["elevation"]), 0.0, math.radians(sun["azimuth"]))
+    render_scene.collection.objects.link(light)
+
+
 def build_scene(scene):
     render_scene = bpy.context.scene
     size = scene["resolution"]
     engine = scene.get("engine", "cycles")
     settings = {"engine": engine, "cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
     # The world first: some of EEVEE's settings are the world's.
-    render_scene.world = furnace_world()
+    lit = scene.get("lighting", "furnace") == "sky_sun"
+    render_scene.world = sky_world(scene["sky"]) if lit else furnace_world()
     furnace_render_settings(render_scene, settings, 1, 1)
+    if lit:
+        add_sun(render_scene, scene["sun"])
     # A point-like pixel filter: every sample of a pixel hits the same point.
     if engine == "cycles":
         render_scene.cycles.filter_width = 0.01
