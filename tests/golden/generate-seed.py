@@ -203,7 +203,7 @@ def principled_coat_node(nodes):
     Principled applies the exact dielectric Fresnel at each microfacet, takes
     its index from IOR (Specular IOR Level 0.5 keeps it), tints F0 by Specular
     Tint and compensates multiple scattering; 3.x's specular takes F0 from
-    Specular (at most 0.08) and ignores Specular Tint over a black base."""
+    Specular and ignores Specular Tint over a black base."""
     if tuple(bpy.app.version[:2]) < (4, 0):
         return None
     node = nodes.new("ShaderNodeBsdfPrincipled")
@@ -372,8 +372,8 @@ def compat_principled_dielectric(node, ior):
     """Make a Principled BSDF (otherwise at its defaults) a dielectric of index
     `ior`. In 4.0+ its specular layer follows IOR (Specular IOR Level 0.5 keeps
     it as is). Before 4.0 IOR drives transmission only; the specular F0 is
-    0.08 x Specular, so Specular = F0(ior) / 0.08 -- capped at 1 (F0 = 0.08,
-    IOR 1.79) by the socket. Cycles 5.2 adds Thin Wall (off by default; on,
+    0.08 x Specular, so Specular = F0(ior) / 0.08 (above 1 for IOR > 1.79: the
+    socket's range ends at 1 in the UI only, and Cycles uses the value). Cycles 5.2 adds Thin Wall (off by default; on,
     it changes transmission and subsurface only): pinned off where it exists,
     so the reference stays the opaque dielectric gloffuse models."""
     node.inputs["IOR"].default_value = ior
@@ -382,7 +382,7 @@ def compat_principled_dielectric(node, ior):
         thin_wall.default_value = False
     if "Specular" in node.inputs:
         f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
-        node.inputs["Specular"].default_value = min(f0 / 0.08, 1.0)
+        node.inputs["Specular"].default_value = f0 / 0.08
 
 
 def compat_eevee_engine():

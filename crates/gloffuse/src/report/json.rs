@@ -35,14 +35,6 @@ mod tests {
                 "suggested": "blender-4",
             })
         );
-        let capped = Note::PrincipledSpecularCapped {
-            blender: "3.4".parse().unwrap(),
-            iors: vec![2.0],
-        };
-        assert_eq!(
-            serde_json::to_value(&capped).unwrap(),
-            json!({"kind": "principled-specular-capped", "blender": "3.4", "iors": [2.0]})
-        );
         let display = Note::DisplayReferred {
             coefficients: "seed".into(),
             under: None,

@@ -33,13 +33,6 @@ pub fn sentence(note: &Note) -> String {
             "{}: the coefficients were fitted for {fitted} masking, but Blender {blender} uses {masking} masking; the preset '{suggested}' suits this Blender.",
             distribution.label(),
         ),
-        Note::PrincipledSpecularCapped { blender, iors } => format!(
-            "Blender {blender}'s Principled BSDF cannot reflect like a coat of IOR {}: its specular F0 is 0.08 × Specular and Specular stops at 1 (F0 0.08, IOR 1.79), so those reference spheres use Specular 1.",
-            iors.iter()
-                .map(|n| n.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
         Note::DisplayReferred {
             coefficients,
             under,

@@ -3,7 +3,7 @@
 
 use super::verdict::{Note, Row, Sweep, WorstSphere};
 use crate::fit::{ColorSpace, preset_for};
-use crate::measure::{BlenderVersion, Engine, fresnel};
+use crate::measure::{BlenderVersion, Engine};
 
 /// The notes for a sweep rendered in `engine` of Blender `version`, with the white Diffuse
 /// sphere's brightness `lighting` (EEVEE) and the judged `rows`, in a fixed order.
@@ -19,7 +19,6 @@ pub fn notes(
         .into_iter()
         .chain(foreign_groups(sweep, engine, version))
         .chain(masking_mismatches(sweep, engine, version))
-        .chain(principled_capped(sweep.ior, version))
         .chain(display_referred(sweep, rows))
         .collect()
 }
@@ -58,20 +57,6 @@ fn masking_mismatches(sweep: &Sweep, engine: Engine, version: BlenderVersion) ->
             suggested: preset_for(engine, version),
         })
         .collect()
-}
-
-/// Before 4.0 Principled's specular F0 is 0.08 × Specular, and Specular stops at 1: the
-/// indices whose coat reflects more.
-fn principled_capped(ior: &[f64], version: BlenderVersion) -> Option<Note> {
-    let iors: Vec<f64> = ior
-        .iter()
-        .copied()
-        .filter(|&n| version.major < 4 && fresnel::f0(n) > 0.08 + 1e-12)
-        .collect();
-    (!iors.is_empty()).then_some(Note::PrincipledSpecularCapped {
-        blender: version,
-        iors,
-    })
 }
 
 /// Display-referred coefficients: the worst failing sphere on each side of 100 % (the
@@ -241,31 +226,6 @@ mod tests {
         );
         assert_eq!(n[1].suggested_preset(), Some("eevee"));
         assert_eq!(n[0].suggested_preset(), None);
-    }
-
-    #[test]
-    fn principled_is_capped_before_4_0_only() {
-        let c = preset("blender-3");
-        let ds = [Distribution::Ggx];
-        let ior = [1.33, 1.5, 2.0];
-        // F0 of IOR 2 is 1/9 > 0.08; of 1.5 it is 0.04.
-        let n = notes(
-            &sweep(&c, &ds, &ior),
-            Engine::Cycles,
-            version("3.4"),
-            None,
-            &[],
-        );
-        assert_eq!(
-            n,
-            [Note::PrincipledSpecularCapped {
-                blender: version("3.4"),
-                iors: vec![2.0],
-            }]
-        );
-        let c4 = preset("blender-4");
-        let s = sweep(&c4, &ds, &ior);
-        assert_eq!(notes(&s, Engine::Cycles, version("4.5"), None, &[]), []);
     }
 
     #[test]

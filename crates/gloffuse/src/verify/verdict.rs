@@ -185,13 +185,6 @@ pub enum Note {
         masking: Masking,
         suggested: &'static str,
     },
-    /// Before 4.0 Principled BSDF's specular F0 stops at 0.08: it cannot reflect like coats
-    /// of these indices, so their reference spheres use Specular 1.
-    PrincipledSpecularCapped {
-        #[serde(serialize_with = "as_text")]
-        blender: BlenderVersion,
-        iors: Vec<f64>,
-    },
     /// The coefficients are display-referred, so their gain misses; the worst failing sphere
     /// on each side of 100 %.
     DisplayReferred {
