@@ -27,7 +27,8 @@
 # shading-normal group (normal_group.py).
 #
 # A module of the gloffuse_blender package; it uses view_groups.py's
-# albedo_lookup, grid_cell, read_cell and bilinear. Functions and constants only.
+# albedo_lookup, grid_cell, read_cell, bilinear and the two plus-diffuse
+# builders. Functions and constants only.
 # ---------------------------------------------------------------------------
 from .compat import mark_asset, metallic_coat_node, principled_coat_node, set_tree_description
 from .nodes import (
@@ -112,15 +113,16 @@ def clamped_ior(layered, chain, ior):
 
 def coat_cell(layered, chain, roughness, mu, n):
     """Nodes that find where (mu, r, n) falls in the coat tables: returns
-    (column in slice k, column in slice k + 1, row, across, up, t), t the
-    fraction of the way from slice k to k + 1 in z = F0^(1/4)."""
+    ((column in slice k, column in slice k + 1, row, across, up, t), rho), t
+    the fraction of the way from slice k to k + 1 in z = F0^(1/4), and
+    rho = (n - 1) / (n + 1) = sqrt(F0)."""
     table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4).
-    ratio = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
-                       chain.math("ADD", "n + 1", n, 1.0))
-    z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", ratio))
+    rho = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
+                     chain.math("ADD", "n + 1", n, 1.0))
+    z = chain.math("SQRT", "z = F0^(1/4)", chain.math("ABSOLUTE", "|(n - 1) / (n + 1)|", rho))
     # The slices are a grid over z / z_max in [0, 1], as r and mu are over theirs.
     k, t = grid_cell(chain, chain.math("MULTIPLY", "z / z_max", z, 1.0 / z_max), slices,
                      "z")  # view_groups.py
@@ -129,7 +131,7 @@ def coat_cell(layered, chain, roughness, mu, n):
     # Slice k's cells start at column k (size - 1); slice k + 1's one slice on.
     first = chain.math("MULTIPLY_ADD", "column in slice k", k, size - 1.0, column)
     second = chain.math("ADD", "column in slice k + 1", first, size - 1.0)
-    return first, second, row, across, up, t
+    return (first, second, row, across, up, t), rho
 
 
 def coat_read(chain, image, cell, what):
@@ -163,17 +165,15 @@ def principled_coat(tree, group_in, n, x):
     return coat.outputs[0]
 
 
-def tinted_ior(chain, n, tint):
+def tinted_ior(chain, rho, tint):
     """Per channel, the index whose F0 is F0(n) x Specular Tint (Principled's
     tint of F0; grazing reflection stays white): (1 + s) / (1 - s) with
-    s = (n - 1) / (n + 1) x sqrt(tint), the tint taken at least 0 (as
-    Principled does) and s below 1. Vector Math's POWER exists where this
-    coat is built (5.0+)."""
+    s = rho x sqrt(tint), rho = (n - 1) / (n + 1) (coat_cell), the tint taken
+    at least 0 (as Principled does) and s below 1. Vector Math's POWER exists
+    where this coat is built (5.0+)."""
     root = chain.vector("POWER", "sqrt(tint)",
                         chain.vector("MAXIMUM", "max(tint, 0)", tint, (0.0, 0.0, 0.0)),
                         (0.5, 0.5, 0.5))
-    rho = chain.math("DIVIDE", "(n - 1) / (n + 1)", chain.math("SUBTRACT", "n - 1", n, 1.0),
-                     chain.math("ADD", "n + 1", n, 1.0))
     s = chain.vector("MINIMUM", "s = min((n - 1) / (n + 1) sqrt(tint), 0.999)",
                      chain.vector("SCALE", "(n - 1) / (n + 1) sqrt(tint)", root, rho),
                      (0.999, 0.999, 0.999))
@@ -182,8 +182,8 @@ def tinted_ior(chain, n, tint):
                         chain.vector("SUBTRACT", "1 - s", (1.0, 1.0, 1.0), s))
 
 
-def metallic_coat(tree, chain, group_in, layered, cell, n):
-    """The Metallic coat (compat.metallic_coat_node, the spec's distribution):
+def metallic_coat(tree, chain, group_in, layered, cell, rho, distribution):
+    """The Metallic coat (compat.metallic_coat_node) of `distribution`:
     single scattering with the dielectric Fresnel at each microfacet, times the
     gain A / E_F read from the coat gain table, as Metallic + (gain - 1) x
     Metallic (a Mix Shader's factor stops at 1, and the gain is below 2). Its
@@ -192,14 +192,14 @@ def metallic_coat(tree, chain, group_in, layered, cell, n):
     Returns its shader socket."""
     if not layered.get("coat_gain_image"):
         return None
-    first = metallic_coat_node(tree.nodes, "BECKMANN")
+    first = metallic_coat_node(tree.nodes, distribution)
     if first is None:
         return None
     gain_image = coat_image(layered, "gain", layered["coat_gain_image"])
     gain = coat_read(chain, gain_image, cell, "G")
     extra = chain.math("SUBTRACT", "gain - 1 = A / E_F - 1", gain, 1.0, name="Coat extra")
-    ior = tinted_ior(chain, n, group_in.outputs["Specular Tint"])
-    second = metallic_coat_node(tree.nodes, "BECKMANN")
+    ior = tinted_ior(chain, rho, group_in.outputs["Specular Tint"])
+    second = metallic_coat_node(tree.nodes, distribution)
     nodes, links = tree.nodes, tree.links
     x = after_chain(chain)
     for node, y, name in ((first, 2 * ROW_STEP, "Coat: Metallic BSDF"),
@@ -236,7 +236,7 @@ def build_layered_group(spec, params):
     mu = view_cosine(tree, spec, group_in, 1, frame)
     chain = Chain(tree, frame, column=2, y=0.0)
     n = clamped_ior(layered, chain, group_in.outputs["IOR"])
-    cell = coat_cell(layered, chain, r, mu, n)
+    cell, rho = coat_cell(layered, chain, r, mu, n)
     a = coat_read(chain, coat_image(layered, "values", layered["coat_image"]), cell, "A")
     base = chain.math("SUBTRACT", "1 - A", 1.0, a, name="Base weight")
     base_color = chain.vector("SCALE", "Base Color × (1 - A)", group_in.outputs["Base Color"],
@@ -251,7 +251,8 @@ def build_layered_group(spec, params):
     if distribution == "GGX":
         coat, kind = principled_coat(tree, group_in, n, after_chain(chain)), "principled"
     elif distribution == "BECKMANN":
-        coat, kind = metallic_coat(tree, chain, group_in, layered, cell, n), "metallic"
+        coat = metallic_coat(tree, chain, group_in, layered, cell, rho, distribution)
+        kind = "metallic"
     if coat is not None:
         shader_plus_diffuse(tree, group_in, coat, base_color,  # view_groups.py
                             after_chain(chain) + 3 * COLUMN_STEP,
