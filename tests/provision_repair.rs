@@ -3,7 +3,7 @@
 //! an error that names the folder and the exact fix. Every test works in a temporary
 //! `XDG_CACHE_HOME`; the real caches are never touched.
 //!
-//! What is not tested here: a successful reinstall, which downloads bpy (~370 MB) from
+//! What is not tested here: a successful reinstall, which downloads bpy (~370 MB; ~950 MB installed) from
 //! PyPI. The repair is followed up to pip: the broken venv is removed, a fresh venv is made
 //! with the real Python 3.11, and pip (offline) fails; the same install path with a
 //! reachable PyPI is what `tests/blender_runner.rs` covers for a first install.
@@ -147,8 +147,14 @@ fn a_broken_venv_is_replaced_by_a_fresh_install() {
         stderr.contains("No matching distribution found for bpy"),
         "pip did not run: {stderr}"
     );
-    // Removed already: no advice to remove it.
+    // Removed already: no advice to remove it, no command naming the removed temporary
+    // venv as one to rerun, and the way to retry.
     assert!(!stderr.contains("rm -rf"), "{stderr}");
+    assert!(!stderr.contains("command: "), "{stderr}");
+    assert!(
+        stderr.contains("run this gloffuse command again"),
+        "{stderr}"
+    );
     let left: Vec<_> = std::fs::read_dir(parent)
         .unwrap()
         .flatten()

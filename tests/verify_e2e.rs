@@ -113,7 +113,20 @@ fn seed_coefficients_fail_and_say_why() {
         .stdout
         .clone();
     let text = String::from_utf8_lossy(&out);
-    assert!(text.contains("FAIL"), "{text}");
+    // The verdict counts the failures first and names the passes and the target.
+    let failed = text.lines().filter(|l| l.ends_with("  FAIL")).count();
+    let passed = text.lines().filter(|l| l.ends_with("  ok")).count();
+    let headline = format!(
+        "FAIL: {failed} of {} corrected spheres (roughness mode) missed their target by more than ±",
+        failed + passed
+    );
+    assert!(failed > 0 && text.contains(&headline), "{headline}\n{text}");
+    assert!(
+        text.contains(&format!("; the other {passed} passed")),
+        "{text}"
+    );
+    assert!(text.contains("the target is 100 %"), "{text}");
+    assert!(text.contains("rings are shown, not judged"), "{text}");
     assert!(text.contains("display-referred"), "{text}");
     // Both ways: at r = 0.4 the seed's GGX gain 100/f = 100/89.79 times E_avg = 0.9405 is
     // 104.7 %; at r = 1 it is 69 %.
@@ -281,6 +294,9 @@ fn junit_and_html_reports_of_a_failing_check() {
         ],
     );
     assert_eq!(code, 1, "{stderr}");
+    let last = stderr.lines().last().unwrap_or_default();
+    let page_line = format!("report: {}", report.join("report.html").display());
+    assert!(last.starts_with(&page_line), "{stderr}");
     let failed: Vec<String> = v["rows"]
         .as_array()
         .unwrap()
@@ -341,6 +357,14 @@ fn junit_and_html_reports_of_a_failing_check() {
     // Failures first.
     let first_ok = html.find("<tr class=\"ok\">").unwrap_or(usize::MAX);
     assert!(html.rfind("<tr class=\"fail\">").unwrap() < first_ok);
+    // The banner says how many failed of how many; the page says rings are not judged in
+    // this mode; the legend sits above the table it explains.
+    let total = v["rows"].as_array().unwrap().len();
+    let headline = format!("<h1>FAIL: {} of {total} corrected spheres", failed.len());
+    assert!(html.contains(&headline), "{headline}");
+    assert!(html.contains("worst ring (not judged)"));
+    assert!(html.find("class=\"legend\"").unwrap() < html.find("<th>status</th>").unwrap());
+    column_labels_sit_over_the_cells(&report.join("deviation.png"));
     let Some(chromium) = common::browser() else {
         return;
     };
@@ -379,6 +403,31 @@ fn junit_and_html_reports_of_a_failing_check() {
     // The thumbnails were drawn: plenty of distinct colours below the banner.
     let distinct: std::collections::HashSet<[u8; 3]> = image.pixels().map(|p| p.0).collect();
     assert!(distinct.len() > 200, "{} colours", distinct.len());
+}
+
+/// deviation.png labels its columns: light text on the dark background in the band just
+/// above the first false-colour cell (found by its colour: the rest is grey).
+fn column_labels_sit_over_the_cells(path: &std::path::Path) {
+    let image = image::open(path).unwrap().to_rgb8();
+    let coloured = |p: &image::Rgb<u8>| {
+        let [r, g, b] = p.0.map(i32::from);
+        (r - g).abs().max((g - b).abs()) > 20
+    };
+    let (top, x0) = image
+        .enumerate_pixels()
+        .find(|(_, _, p)| coloured(p))
+        .map(|(x, y, _)| (y, x))
+        .expect("false-colour cells");
+    let band = top.saturating_sub(20)..top;
+    let lit = band
+        .flat_map(|y| (x0.saturating_sub(24)..x0 + 24).map(move |x| (x, y)))
+        .filter(|&(x, y)| x < image.width() && image.get_pixel(x, y).0[1] > 150)
+        .count();
+    assert!(
+        lit > 10,
+        "{lit} text pixels over the first column of {}",
+        path.display()
+    );
 }
 
 fn label(distribution: &Value) -> &'static str {

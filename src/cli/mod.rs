@@ -248,6 +248,13 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             }
             let out = summary(out, &mut stderr, &[v.junit.as_deref()]);
             emit(out, v.json, report, text::verify)?;
+            // Last, below the table, where a person looks: the page to open.
+            if let Some(dir) = &v.report {
+                eprintln_quietly(&format!(
+                    "report: {} (open it in a browser)",
+                    dir.join("report.html").display()
+                ));
+            }
             Ok(verdict(report.pass))
         }
         Command::Audit(a) => audit(&a, out, &mut stderr, &terminal),

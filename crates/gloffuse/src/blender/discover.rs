@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use super::environment::{
-    BPY_SERIES, ENV_VAR, Environment, bpy_venv_dir, broken_venv, venv_python, which,
+    BPY_SERIES, BPY_SIZE, ENV_VAR, Environment, bpy_venv_dir, broken_venv, venv_python, which,
 };
 use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, probe_as};
 use super::process::Cancel;
@@ -302,7 +302,7 @@ fn none_new_enough(need: Need, looked: &[Hint]) -> Error {
     Error::BlenderNotFound(m.then(Hint::new(
         format!(
             "\n{{}} forbids installing bpy {BPY_SERIES} LTS, which would do: drop it to let \
-             gloffuse install bpy into its cache (~370 MB), or set {ENV_VAR} to a Blender \
+             gloffuse install bpy into its cache ({BPY_SIZE}), or set {ENV_VAR} to a Blender \
              {wanted} or later (a blender executable, or a Python that imports bpy)."
         ),
         [Field::NoProvision],
@@ -328,7 +328,7 @@ fn broken_cache(venv: &std::path::Path, why: &str) -> Error {
 fn removal_advice(venv: &std::path::Path) -> Hint {
     Hint::text(format!(
         "\nRemove it with: rm -rf {}\n(gloffuse installs bpy {BPY_SERIES} there again when \
-         it next needs it; ~370 MB.)",
+         it next needs it; {BPY_SIZE}.)",
         super::process::shell_quote(venv.as_os_str())
     ))
 }
@@ -368,7 +368,7 @@ fn not_found(looked: &[Hint]) -> Error {
         format!(
             "\nPoint it at one with {{}} PATH or {ENV_VAR}=PATH (a blender executable, or a \
              Python that imports bpy), install one (apt-get install blender), or drop {{}} to \
-             let gloffuse install bpy {BPY_SERIES} LTS (~370 MB) into its cache."
+             let gloffuse install bpy {BPY_SERIES} LTS ({BPY_SIZE}) into its cache."
         ),
         [Field::Blender, Field::NoProvision],
     );

@@ -10,10 +10,10 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use super::environment::{
-    BPY_REQUIREMENT, BPY_SERIES, ENV_VAR, Environment, broken_venv, venv_python, which,
+    BPY_REQUIREMENT, BPY_SERIES, BPY_SIZE, ENV_VAR, Environment, broken_venv, venv_python, which,
 };
 use super::probe::{Blender, BlenderKind, PROBE_TIMEOUT, Source, last_lines, probe_as};
-use super::process::{Cancel, Exit, run_captured, shell_join};
+use super::process::{Cancel, Exit, run_captured};
 use crate::error::{Error, Field, Hint};
 use crate::progress::Progress;
 
@@ -125,7 +125,7 @@ fn announce_install(venv: &Path, skipped: &[Hint], progress: &dyn Progress) {
     progress.advise(&Hint::new(
         format!(
             "no Blender found; installing bpy {BPY_SERIES} LTS (Blender as a Python \
-             module, ~370 MB) into {} — point {{}} or {ENV_VAR} at a Blender to skip this",
+             module; {BPY_SIZE}) into {} — point {{}} or {ENV_VAR} at a Blender to skip this",
             venv.display()
         ),
         [Field::Blender],
@@ -191,7 +191,6 @@ struct Installer<'a> {
 impl Installer<'_> {
     /// Runs one step, its output to the log (made afresh) or to stderr.
     fn run(&self, argv: Vec<OsString>) -> Result<(), Error> {
-        let command = shell_join(&argv);
         let mut cmd = Command::new(&argv[0]);
         cmd.args(&argv[1..]).stdin(Stdio::null());
         let out = self.output()?;
@@ -204,8 +203,8 @@ impl Installer<'_> {
             .status();
         match status {
             Ok(s) if s.success() => Ok(()),
-            Ok(s) => Err(self.failure(format!("{s}"), command)),
-            Err(e) => Err(self.failure(e.to_string(), command)),
+            Ok(s) => Err(self.failure(format!("{s}"))),
+            Err(e) => Err(self.failure(e.to_string())),
         }
     }
 
@@ -223,8 +222,10 @@ impl Installer<'_> {
         }
     }
 
-    /// The error of a step that failed with `what`: the log's last lines, and advice.
-    fn failure(&self, what: String, command: String) -> Error {
+    /// The error of a step that failed with `what`: the log's last lines, and advice. The
+    /// step ran in a temporary venv that is removed as the error returns, so no command of
+    /// it is offered to rerun: gloffuse itself is.
+    fn failure(&self, what: String) -> Error {
         let mut message = format!(
             "installing bpy {BPY_SERIES} into {} failed: {what}",
             self.venv.display()
@@ -240,7 +241,8 @@ impl Installer<'_> {
         }
         let advice = Hint::new(
             format!(
-                "\n  (bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or \
+                "\n  (the partial install was removed; run this gloffuse command again to \
+                 retry. bpy {BPY_SERIES} needs CPython 3.11 and network access to PyPI; or \
                  point {{}} or {ENV_VAR} at a Blender)"
             ),
             [Field::Blender],
@@ -248,7 +250,7 @@ impl Installer<'_> {
         Error::Blender {
             message: Hint::text(message).then(advice),
             log: self.log.clone(),
-            command: Some(command),
+            command: None,
         }
     }
 }

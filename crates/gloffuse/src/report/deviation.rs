@@ -12,6 +12,7 @@ use super::png::{
     BACKGROUND, FAMILY, LABEL_BACKGROUND, LABEL_TEXT, backend, register_font, srgb8, text_size,
     write_error, write_png,
 };
+use super::words;
 use crate::Error;
 use crate::verify::stats::RINGS;
 use crate::verify::{Rendered, VerifyReport};
@@ -86,9 +87,9 @@ pub fn cell_image(rendered: &Rendered, index: usize, targets: &[[f64; 3]]) -> Ve
         .collect()
 }
 
-/// `deviation.png`: a title (Blender version, coefficients, samples), one row per
-/// distribution of its corrected spheres in false colour, a column per roughness, and the
-/// scale's legend.
+/// `deviation.png`: a title (Blender version, coefficients, samples; in roughness mode
+/// what that mode leaves off target), one row per distribution of its corrected spheres in
+/// false colour, a column per roughness labelled with it, and the scale's legend.
 pub fn sheet(report: &VerifyReport, rendered: &Rendered, out: &Path) -> Result<(), Error> {
     register_font().map_err(|m| write_error(out, m))?;
     let layout = Layout::new(report, rendered, out)?;
@@ -107,8 +108,11 @@ const LABEL_PX: f64 = 14.0;
 /// Space around the sheet's parts, and between its cells.
 const PAD: usize = 10;
 const GAP: usize = 4;
-/// Heights of the title above the cells and of the scale's legend below them.
+/// Heights of the title (two lines; a third in roughness mode), of the roughness labels
+/// over the columns, and of the scale's legend below the cells.
 const TITLE_H: usize = 54;
+const SCOPE_H: usize = 18;
+const COLUMN_LABEL_H: usize = 20;
 const LEGEND_H: usize = 64;
 
 /// Where the deviation sheet's parts go, in pixels.
@@ -117,6 +121,10 @@ struct Layout {
     series: Vec<String>,
     cell: usize,
     columns: usize,
+    /// The roughness over each column (`r = 0.5`), blank where no corrected sphere is.
+    column_labels: Vec<String>,
+    /// Where the cells start: below the title, the scope line and the column labels.
+    top: usize,
     /// Width of the label column: where the cells start.
     left: usize,
     width: usize,
@@ -132,6 +140,13 @@ impl Layout {
         let mut series: Vec<_> = report.rows.iter().map(|r| r.series()).collect();
         series.dedup();
         let columns = plan.columns.max(1);
+        let mut column_labels = vec![String::new(); columns];
+        for row in &report.rows {
+            let j = plan.rows[row.id].corrected % columns;
+            column_labels[j] = format!("r = {}", row.roughness);
+        }
+        let scope = if report.mode.per_pixel() { 0 } else { SCOPE_H };
+        let top = TITLE_H + scope + COLUMN_LABEL_H;
         let mut label_w = 0;
         for name in &series {
             label_w = label_w.max(
@@ -141,13 +156,15 @@ impl Layout {
             );
         }
         let left = label_w as usize + 2 * PAD;
-        let width = (left + columns * (cell + GAP) + PAD).max(560);
-        let height = TITLE_H + series.len() * (cell + GAP) + LEGEND_H;
+        let width = (left + columns * (cell + GAP) + PAD).max(640);
+        let height = top + series.len() * (cell + GAP) + LEGEND_H;
         let bar = (PAD + 60, width - 2 * PAD - 120, height - LEGEND_H + 10, 14);
         Ok(Layout {
             series,
             cell,
             columns,
+            column_labels,
+            top,
             left,
             width,
             height,
@@ -161,7 +178,7 @@ impl Layout {
 
     /// The top of row `k`.
     fn row_y(&self, k: usize) -> usize {
-        TITLE_H + k * (self.cell + GAP)
+        self.top + k * (self.cell + GAP)
     }
 }
 
@@ -225,6 +242,14 @@ fn draw_text(
         (PAD, 16),
     )?;
     draw(&subtitle(report), 12.0, left_mid, (PAD, 38))?;
+    if !report.mode.per_pixel() {
+        draw(words::ROUGHNESS_PICTURE, 12.0, left_mid, (PAD, TITLE_H + 2))?;
+    }
+    let bottom_centre = Pos::new(HPos::Center, VPos::Bottom);
+    for (j, label) in layout.column_labels.iter().enumerate() {
+        let x = layout.left + j * (layout.cell + GAP) + layout.cell / 2;
+        draw(label, 12.0, bottom_centre, (x, layout.top - 4))?;
+    }
     for (k, name) in layout.series.iter().enumerate() {
         let y = layout.row_y(k) + layout.cell / 2;
         draw(name, LABEL_PX, right_mid, (layout.left - PAD, y))?;

@@ -6,7 +6,7 @@
 
 use std::fmt::Write as _;
 
-use super::{deviation, png};
+use super::{deviation, png, words};
 use crate::verify::verdict::MIN_RING_PIXELS;
 use crate::verify::{Rendered, Row, VerifyReport, reference_label};
 
@@ -17,7 +17,6 @@ pub const FAIL_COLOUR: &str = "#b3261e";
 /// `rerun` is the command line that reproduces the whole check (the CLI passes its own);
 /// `files` are the report's other files, linked by name.
 pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[String]) -> String {
-    let failed = report.rows.iter().filter(|r| !r.pass).count();
     let verdict = if report.pass { "PASS" } else { "FAIL" };
     let banner = if report.pass {
         PASS_COLOUR
@@ -26,12 +25,11 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
     };
     let mut s = String::new();
     write_head(&mut s, verdict, banner);
-    write_banner(&mut s, report, verdict, failed);
+    write_banner(&mut s, report);
     write_thresholds(&mut s, report);
     write_rerun(&mut s, report, rerun);
     write_notes(&mut s, report);
     write_spheres(&mut s, report, rendered);
-    write_scale(&mut s);
     write_reference(&mut s, report, rendered);
     write_files(&mut s, files);
     s.push_str("</main></body></html>\n");
@@ -55,7 +53,9 @@ fn write_head(s: &mut String, verdict: &str, banner: &str) {
          td.fail {{ color: {FAIL_COLOUR}; font-weight: bold; }} td.ok {{ color: {PASS_COLOUR}; }}\n\
          img {{ image-rendering: pixelated; width: 96px; height: 96px; display: block; }}\n\
          pre {{ background: #eee; padding: 6px 10px; white-space: pre-wrap; word-break: break-all; }}\n\
-         .scale {{ width: 320px; height: 14px; background: linear-gradient(to right, {}, {}, {}); }}\n\
+         .legend {{ width: 360px; margin: 4px 0 8px; }} .scope {{ max-width: 60em; }} .caption {{ white-space: nowrap; }}\n\
+         .ticks {{ display: flex; justify-content: space-between; font-size: 12px; }}\n\
+         .scale {{ width: 100%; height: 14px; background: linear-gradient(to right, {}, {}, {}); }}\n\
          </style></head><body>\n",
         css(deviation::colour(-deviation::SCALE)),
         css(deviation::colour(0.0)),
@@ -63,16 +63,15 @@ fn write_head(s: &mut String, verdict: &str, banner: &str) {
     );
 }
 
-/// The coloured banner: the verdict, how many spheres kept their promise, and how the
-/// sweep was rendered; it opens `<main>`.
-fn write_banner(s: &mut String, report: &VerifyReport, verdict: &str, failed: usize) {
+/// The coloured banner: the verdict in words and how the sweep was rendered; it opens
+/// `<main>`.
+fn write_banner(s: &mut String, report: &VerifyReport) {
     let info = &report.render;
     let _ = writeln!(
         s,
-        "<header><h1>{verdict}: {} of {} corrected spheres as promised</h1>\
+        "<header><h1>{}</h1>\
          <div>Blender {} ({} masking) · coefficients {} · {} mode · colour {} ({}) · {} px per sphere, {} spp, seed {} · rendered in {:.1} s</div></header><main>",
-        report.rows.len() - failed,
-        report.rows.len(),
+        escape(&words::headline(report)),
         escape(&info.blender_version),
         escape(&info.masking),
         escape(&report.coefficients),
@@ -91,17 +90,27 @@ fn write_banner(s: &mut String, report: &VerifyReport, verdict: &str, failed: us
     );
 }
 
-/// The named thresholds the verdict applies.
+/// The named thresholds the verdict applies, what they are measured against, and what
+/// the mode judges.
 fn write_thresholds(s: &mut String, report: &VerifyReport) {
+    let rings = if report.mode.per_pixel() {
+        format!(
+            "<li><b>ring tolerance</b>: every view-cosine ring with at least {MIN_RING_PIXELS} \
+             fully covered pixels within ±{} % of its target.</li>",
+            report.ring_tolerance_percent
+        )
+    } else {
+        "<li><b>rings</b>: not judged in this mode.</li>".to_string()
+    };
     let _ = writeln!(
         s,
-        "<h2>Thresholds</h2><ul>\
-         <li><b>tolerance</b>: every channel of a corrected sphere's mean within ±{} % of what the correction promises.</li>\
-         <li><b>ring tolerance</b> (every mode but roughness): every view-cosine ring with at least {MIN_RING_PIXELS} fully covered pixels within ±{} %.</li>\
-         <li>The false-colour thumbnails saturate at ±{} %.</li></ul>",
+        "<h2>What is judged</h2><p class=\"scope\">{}</p><ul>\
+         <li><b>tolerance</b>: every channel of a corrected sphere's mean within ±{} % of its target; {}.</li>\
+         {rings}<li>The <b>predicted</b> column: {}.</li></ul>",
+        escape(words::scope(report.mode)),
         report.tolerance_percent,
-        report.ring_tolerance_percent,
-        100.0 * deviation::SCALE,
+        escape(&words::target(report)),
+        escape(words::PREDICTED),
     );
 }
 
@@ -136,10 +145,17 @@ fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
         crate::generate::Mode::Layered => ("Mix Shader", "layered"),
         _ => ("uncorrected", "corrected"),
     };
+    let ring = if report.mode.per_pixel() {
+        "worst ring"
+    } else {
+        "worst ring (not judged)"
+    };
+    s.push_str("<h2>Spheres</h2>");
+    write_scale(s);
     let _ = writeln!(
         s,
-        "<h2>Spheres</h2><table><tr><th>status</th><th>sphere</th><th>{plain}</th>\
-         <th>{fixed}</th><th>predicted</th><th>±SE</th><th>worst ring</th>\
+        "<table><tr><th>status</th><th>sphere</th><th>{plain}</th>\
+         <th>{fixed}</th><th>predicted</th><th>±SE</th><th>{ring}</th>\
          <th>{plain}</th><th>{fixed}</th><th>deviation</th></tr>",
     );
     let mut rows: Vec<_> = report.rows.iter().collect();
@@ -179,12 +195,14 @@ fn write_sphere_row(s: &mut String, row: &Row, rendered: &Rendered) {
     );
 }
 
-/// The legend of the false-colour thumbnails.
+/// The legend of the false-colour thumbnails, above the table they explain: the bar with
+/// its end labels under its ends and the middle under its middle.
 fn write_scale(s: &mut String) {
     let _ = writeln!(
         s,
-        "<p>Deviation scale: <span style=\"display:inline-block;vertical-align:middle\" class=\"scale\"></span> \
-         −{0} % (darker) · 0 · +{0} % (brighter)</p>",
+        "<div class=\"legend\"><div class=\"caption\">Deviation column: each pixel of the corrected sphere against its target</div>\
+         <div class=\"scale\"></div><div class=\"ticks\"><span>−{0} % (darker)</span><span>0</span>\
+         <span>+{0} % (brighter)</span></div></div>",
         100.0 * deviation::SCALE
     );
 }

@@ -1,7 +1,7 @@
 //! ⑤ Report: renderers of the verify verdict, one file each — `table` (terminal), `json`
 //! (machines), `junit` (CI servers), `html` (a page for people), `png` (the contact sheet
 //! and the brightness plot), `deviation` (the false-colour view), `notes` (the verdict's
-//! notes in words) — and the report folder that holds them with the rendered EXR.
+//! notes in words), `words` (the verdict and the mode in words) — and the report folder that holds them with the rendered EXR.
 
 pub mod audit;
 pub mod deviation;
@@ -11,6 +11,7 @@ pub mod junit;
 pub mod notes;
 pub mod png;
 pub mod table;
+pub mod words;
 
 use std::path::{Path, PathBuf};
 

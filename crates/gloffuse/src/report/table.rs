@@ -6,6 +6,8 @@ use crate::generate::{ColorModel, Mode};
 use crate::measure::Engine;
 use crate::verify::VerifyReport;
 
+use super::words;
+
 /// The verdict as a terminal table: a title line, one row per sphere, the references,
 /// the verdict line, notes, and the log and rerun command when something failed.
 pub fn render(report: &VerifyReport) -> String {
@@ -121,25 +123,18 @@ fn write_references(s: &mut String, report: &VerifyReport, w: usize, eevee: bool
     }
 }
 
-/// The verdict line: how many corrected spheres kept within which tolerances.
+/// The verdict line, what the target is, what the mode judges, and what "predicted" is.
 fn write_verdict(s: &mut String, report: &VerifyReport) {
-    let failed = report.rows.iter().filter(|r| !r.pass).count();
-    let rings = match report.mode {
-        Mode::Roughness => String::new(),
-        _ => format!(
-            ", every view-cosine ring within ±{} %",
-            report.ring_tolerance_percent
-        ),
-    };
+    let _ = writeln!(s, "{}", words::headline(report));
     let _ = writeln!(
         s,
-        "{}: {} of {} corrected spheres ({:?} mode) within ±{} % of 100 %{rings}",
-        if report.pass { "PASS" } else { "FAIL" },
-        report.rows.len() - failed,
-        report.rows.len(),
-        report.mode,
-        report.tolerance_percent
+        "({}; predicted: {})",
+        words::target(report),
+        words::PREDICTED
     );
+    if report.mode == Mode::Roughness {
+        let _ = writeln!(s, "{}", words::scope(report.mode));
+    }
 }
 
 /// The "in Cycles" column of an EEVEE sweep (blank where Cycles has no value); nothing
