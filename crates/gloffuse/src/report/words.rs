@@ -63,7 +63,7 @@ pub fn scope(mode: Mode) -> &'static str {
              sphere's centre and rim stay off target in opposite directions (which is \
              brighter depends on the roughness). So only the mean is judged; the rings are \
              shown, not judged, and red and blue rings in the false colour are expected. \
-             --mode view corrects every view direction."
+             View mode corrects every view direction."
         }
         Mode::View | Mode::Multiscatter => {
             "This mode corrects every view direction, so both the sphere's mean and every \
@@ -83,4 +83,4 @@ pub const PREDICTED: &str = "what these coefficients should give, from the \
 
 /// [`scope`]'s roughness mode in one line, for the false-colour picture.
 pub const ROUGHNESS_PICTURE: &str = "Roughness mode corrects only each sphere's mean: centres \
-     and rims off target in opposite directions are expected, not judged (--mode view corrects them)";
+     and rims off target in opposite directions are expected, not judged (view mode corrects them)";
