@@ -95,6 +95,7 @@ find_python() {
 works_bpy() { [ -x "$1/bin/python" ] && "$1/bin/python" -c "import bpy" >/dev/null 2>&1; }
 
 venv_install() { # dir, pip requirement: made under DIR.partial, renamed when complete
+    # (for bpy, which is run as `python -c`; see provision_tool for venvs with programs)
     local dir="$1"
     say "installing $2 into $dir"
     rm -rf "$dir.partial"
@@ -136,10 +137,17 @@ share_bpy_45() {
     fi
 }
 
+# A tool's venv is made where it stays: pip writes the venv's path into its programs'
+# first lines, so a venv renamed after the install (as venv_install does) cannot run them.
+# A marker written last says the install finished.
 provision_tool() { # name, program in its venv's bin, pip requirement
     local dir="$cache/$1"
-    if [ ! -x "$dir/bin/$2" ] || ! "$dir/bin/$2" --version >/dev/null 2>&1; then
-        venv_install "$dir" "$3"
+    if [ ! -e "$dir/.installed" ] || ! "$dir/bin/$2" --version >/dev/null 2>&1; then
+        say "installing $3 into $dir"
+        rm -rf "$dir"
+        "$python" -m venv "$dir"
+        "$dir/bin/python" -m pip install --quiet --progress-bar off "$3"
+        touch "$dir/.installed"
     fi
 }
 
