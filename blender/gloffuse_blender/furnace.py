@@ -370,13 +370,26 @@ def furnace_scene(furnace):
     return scene
 
 
+def _log_render_status(stats=None, *_):
+    # bpy (Blender as a module) logs no render status, but hands this handler
+    # the line Blender's own binary prints ("Remaining: … | Sample 1/64"), which
+    # gloffuse reads from the log to follow the render. Blender 3.4's binary
+    # passes no text here (it prints the line itself).
+    if isinstance(stats, str):
+        print("gloffuse render: " + stats, flush=True)
+
+
 def render_sweep(output):
     """Render the current scene once and save it to `output`; returns render seconds."""
     directory = os.path.dirname(output)
     if directory:
         os.makedirs(directory, exist_ok=True)
     start = time.perf_counter()
-    bpy.ops.render.render(write_still=False)
+    bpy.app.handlers.render_stats.append(_log_render_status)
+    try:
+        bpy.ops.render.render(write_still=False)
+    finally:
+        bpy.app.handlers.render_stats.remove(_log_render_status)
     seconds = time.perf_counter() - start
     # save_render writes the scene's image settings; for OpenEXR that is the
     # scene-linear result whatever the view transform.

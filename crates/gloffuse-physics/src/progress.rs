@@ -17,6 +17,12 @@ pub trait Progress: Sync {
     fn set(&self, _done: u64) {}
     /// One more step of the current task is finished.
     fn step(&self) {}
+    /// A task whose length is known only as it runs (a render: Cycles estimates it) starts;
+    /// `estimate` follows it instead of `set` or `step`.
+    fn begin_estimated(&self, _message: &str) {}
+    /// The estimated task is `done` (0 to 1) finished and needs about `seconds_left` more
+    /// (none: no estimate yet).
+    fn estimate(&self, _done: f64, _seconds_left: Option<f64>) {}
     /// The current task is over (finished or failed).
     fn end(&self) {}
 }

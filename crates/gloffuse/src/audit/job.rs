@@ -11,12 +11,11 @@ use serde::{Deserialize, Serialize};
 
 use super::rules::{RuleRange, ranges};
 use crate::Error;
-use crate::blender::{Blender, BlenderOptions, Run, runs};
+use crate::blender::{Blender, BlenderOptions, Run, run_following_render, runs};
 use crate::generate::{GenerateParams, Job, assemble, layered_group_name, multiscatter_group_name};
 use crate::measure::{Distribution, Engine};
 use crate::output::write_output;
 use crate::verify::RenderSettings;
-use crate::verify::render::run_watching_samples;
 
 /// The `audit` section of the job's parameter document.
 #[derive(Clone, Debug, Serialize)]
@@ -137,7 +136,7 @@ pub struct JobSettings<'a> {
     pub render: Option<RenderSettings>,
     /// About how many materials the file holds (for the grid's shape).
     pub materials: usize,
-    /// Told the fraction of the render done (from the samples Cycles logs) while it runs.
+    /// Told the fraction of the render done (by Cycles' estimate) while it runs.
     pub on_fraction: &'a (dyn Fn(f64) + Sync),
 }
 
@@ -195,8 +194,7 @@ pub fn run_job(
         cancel: s.options.cancel.clone(),
         log: log.clone(),
     };
-    let samples = f64::from(render.samples.max(1));
-    let out = run_watching_samples(&run, &|n| (s.on_fraction)(n as f64 / samples))?;
+    let out = run_following_render(&run, &|e| (s.on_fraction)(e.done))?;
     let result: JobResult = serde_json::from_value(out.result).map_err(|e| Error::Blender {
         message: format!("the audit job's result line is not what gloffuse expects ({e})").into(),
         log: Some(log.clone()),

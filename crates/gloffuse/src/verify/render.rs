@@ -1,14 +1,14 @@
 //! Rendering a furnace plan in one Blender process and reading the EXR back.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
 
 use super::image::{Rgba, read_rgba};
 use super::plan::Plan;
 use super::stats::{SphereStats, sphere_stats};
 use crate::Error;
-use crate::blender::{Blender, BlenderOptions, Run, RunOutput, command_line, run_script, runs};
+use crate::blender::{
+    Blender, BlenderOptions, Run, RunOutput, command_line, run_following_render, runs,
+};
 use crate::generate::{GenerateParams, Job, Mode, assemble};
 use crate::output::write_output;
 use crate::progress::Progress;
@@ -93,41 +93,16 @@ pub fn render(
     })
 }
 
-/// Runs the render while `progress` follows the samples Cycles logs.
+/// Runs the render while `progress` follows it by Cycles' own estimate.
 fn run_followed(run: &Run, plan: &Plan, progress: &dyn Progress) -> Result<RunOutput, Error> {
-    progress.begin(
-        &format!(
-            "rendering {} spheres in Blender {}",
-            plan.cells.len(),
-            run.blender.version_string
-        ),
-        u64::from(plan.settings.samples),
-    );
-    let outcome = run_watching_samples(run, &|s| progress.set(s));
+    progress.begin_estimated(&format!(
+        "rendering {} spheres in Blender {}",
+        plan.cells.len(),
+        run.blender.version_string
+    ));
+    let outcome = run_following_render(run, &|e| progress.estimate(e.done, e.seconds_left));
     progress.end();
     outcome
-}
-
-/// Runs `run` while a watcher passes `on_sample` each "Sample N" Cycles logs (the highest
-/// so far, every 200 ms).
-pub(crate) fn run_watching_samples(
-    run: &Run,
-    on_sample: &(dyn Fn(u64) + Sync),
-) -> Result<RunOutput, Error> {
-    let done = AtomicBool::new(false);
-    std::thread::scope(|scope| {
-        scope.spawn(|| {
-            while !done.load(Ordering::Relaxed) {
-                if let Some(s) = last_sample(&run.log) {
-                    on_sample(s);
-                }
-                std::thread::sleep(Duration::from_millis(200));
-            }
-        });
-        let outcome = run_script(run);
-        done.store(true, Ordering::Relaxed);
-        outcome
-    })
 }
 
 /// The rendered EXR, which must be as large as `plan` needs; a failure names the render's
@@ -156,14 +131,4 @@ fn read_sweep(exr: &Path, plan: &Plan, log: &Path, command: &str) -> Result<Rgba
         });
     }
     Ok(image)
-}
-
-/// The highest "Sample N/M" Cycles has logged so far.
-fn last_sample(log: &Path) -> Option<u64> {
-    let text = std::fs::read(log).ok()?;
-    let text = String::from_utf8_lossy(&text);
-    let at = text.rfind("Sample ")?;
-    let rest = &text[at + 7..];
-    let n: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
-    n.parse().ok()
 }
