@@ -606,7 +606,9 @@ fn a_failed_install_leaves_nothing_that_looks_valid() {
     let (message, log, command) = blender_error(find_blender_in(&opts, &env, &Quiet).unwrap_err());
     assert!(message.contains("installing bpy 4.5"), "{message}");
     assert!(message.contains("No matching distribution"), "{message}");
-    assert!(command.unwrap().contains("'bpy>=4.5,<4.6'"));
+    // The pip command ran in a venv that is gone: the advice is to rerun gloffuse instead.
+    assert_eq!(command, None);
+    assert!(message.contains("run this gloffuse command again"), "{message}");
     assert!(log.unwrap().exists());
     assert_eq!(leftovers(&cache), Vec::<String>::new());
 }
