@@ -23,9 +23,10 @@ from .compat import blender_version_string
 from .groups import build_all, group_names, library_contents, mark_library
 from .nodes import set_aside_untagged
 from .params import load_params
-from .previews import render_previews
+from .previews import preview_groups, render_previews
 from .runtime import (
     ScriptArgumentParser,
+    log_step,
     open_blend,
     parse_script_args,
     result_line,
@@ -50,6 +51,18 @@ def parse_generate_args(argv=None):
     return parse_script_args(parser, argv)
 
 
+class _Steps:
+    """The generate job's steps, told to gloffuse as each begins (log_step)."""
+
+    def __init__(self, total):
+        self.total = total
+        self.done = 0
+
+    def next(self, what):
+        log_step(self.done, self.total, what)
+        self.done += 1
+
+
 def generate_main(document_text):
     options = parse_generate_args()
     params = load_params(document_text)
@@ -69,12 +82,20 @@ def generate_main(document_text):
         # file's cube, camera and light.
         bpy.ops.wm.read_factory_settings(use_empty=True)
     renamed = set_aside_untagged(group_names(params))
-    built = build_all(params)
+    specs = params["groups"]
+    previews = bool(params.get("previews")) and bpy.app.background
+    steps = _Steps(len(specs) + (sum(len(preview_groups(s)) for s in specs) if previews else 0)
+                   + (1 if options.save else 0))
+    built = build_all(params, on_spec=lambda _i, spec: steps.next(
+        "building %s and its groups" % spec["shader_group"]))
     if new_library:
         mark_library(params)
-    if params.get("previews") and bpy.app.background:
+    if previews:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
-            render_previews(built, directory)
+            render_previews(built, directory, on_preview=lambda name: steps.next(
+                "rendering the preview of %s" % name))
+    if options.save:
+        steps.next("saving the .blend")
     saved = save_blend(options.save, options.compress) if options.save else None
     names = []
     for _spec, trees in built:

@@ -34,18 +34,21 @@ def group_names(params):
     return names
 
 
-def build_all(params):
+def build_all(params, on_spec=None):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
     with spec["layered"] the layered group, after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
-    with the first spec that uses it."""
+    with the first spec that uses it. on_spec(index, spec), if given, is told
+    before each spec is built."""
     validate_params(params)
     built = []
     normal_names = set()
-    for spec in params["groups"]:
+    for index, spec in enumerate(params["groups"]):
+        if on_spec is not None:
+            on_spec(index, spec)
         correction = build_correction_group(spec, params)
         trees = [correction, build_shader_group(spec, params, correction)]
         normal = spec.get("normal_group")

@@ -102,11 +102,24 @@ def _set_preview(tree, path):
         bpy.ops.ed.lib_id_load_custom_preview(filepath=path)
 
 
-def render_previews(built, directory):
-    """Render a preview for every group of `built` (groups.py's build_all) with a
-    BSDF output, into `directory`, and set it as the custom preview of that
-    group and of the groups without one that belong to it (the normal group
-    gets the first view group's). Headless only."""
+def preview_groups(spec):
+    """The groups of `spec` that get a rendered preview, in order, each with the
+    helper groups that share it: [(shader group name, [helper names])]."""
+    view = spec.get("view") or {}
+    layered = spec.get("layered") or {}
+    pairs = [(spec["shader_group"], [spec["correction_group"]]),
+             (view.get("shader_group"), [view.get("correction_group")]),
+             (view.get("multiscatter_group"), []),
+             (layered.get("shader_group"), [])]
+    return [(name, helpers) for name, helpers in pairs if name]
+
+
+def render_previews(built, directory, on_preview=None):
+    """Render a preview for every group of `built` (groups.py's build_all) that
+    preview_groups names, into `directory`, and set it as the custom preview of
+    that group and of the groups without one that belong to it (the normal
+    group gets the first view group's). on_preview(tree name), if given, is
+    told before each render. Headless only."""
     images_before = {image.name for image in bpy.data.images}
     made = []
     scene, mesh = _preview_scene(made)
@@ -114,16 +127,12 @@ def render_previews(built, directory):
         shown = {}
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
-            view = spec.get("view") or {}
-            layered = spec.get("layered") or {}
-            pairs = [(spec["shader_group"], [spec["correction_group"]]),
-                     (view.get("shader_group"), [view.get("correction_group")]),
-                     (view.get("multiscatter_group"), []),
-                     (layered.get("shader_group"), [])]
-            for shader_name, helpers in pairs:
+            for shader_name, helpers in preview_groups(spec):
                 tree = by_name.get(shader_name)
                 if tree is None:
                     continue
+                if on_preview is not None:
+                    on_preview(tree.name)
                 path = os.path.join(directory, "preview %d.png" % len(shown))
                 _render_group(scene, mesh, tree, path, made)
                 _set_preview(tree, path)
@@ -131,6 +140,8 @@ def render_previews(built, directory):
                 for helper in helpers:
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
+            view = spec.get("view") or {}
+            layered = spec.get("layered") or {}
             normal = by_name.get(spec.get("normal_group"))
             first_view = view.get("shader_group") or layered.get("shader_group")
             if normal is not None and first_view in shown:
@@ -141,4 +152,3 @@ def render_previews(built, directory):
         for image in list(bpy.data.images):
             if image.name not in images_before and image.type in ("RENDER_RESULT", "COMPOSITING"):
                 bpy.data.images.remove(image)
-

@@ -100,6 +100,12 @@ def result_line(payload):
     return "GLOFFUSE_RESULT " + json.dumps(payload, sort_keys=True)
 
 
+def log_step(done, total, what):
+    """Say on stdout, which gloffuse reads as the job runs, that `done` of
+    `total` steps are finished and `what` comes next."""
+    print("gloffuse step %d/%d: %s" % (done, total, what), flush=True)
+
+
 def job_is_the_program():
     """Whether this job is the program itself (python THIS.py), not code that
     another script runs in its own process (exec), whose process is not ours

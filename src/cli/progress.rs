@@ -88,6 +88,10 @@ impl Progress for Terminal {
         self.with_bar(|bar| bar.inc(1));
     }
 
+    fn doing(&self, what: &str) {
+        self.with_bar(|bar| bar.set_message(what.to_string()));
+    }
+
     fn end(&self) {
         if let Ok(mut guard) = self.bar.lock()
             && let Some(bar) = guard.take()

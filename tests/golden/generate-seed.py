@@ -2128,18 +2128,21 @@ def group_names(params):
     return names
 
 
-def build_all(params):
+def build_all(params, on_spec=None):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
     with spec["layered"] the layered group, after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
-    with the first spec that uses it."""
+    with the first spec that uses it. on_spec(index, spec), if given, is told
+    before each spec is built."""
     validate_params(params)
     built = []
     normal_names = set()
-    for spec in params["groups"]:
+    for index, spec in enumerate(params["groups"]):
+        if on_spec is not None:
+            on_spec(index, spec)
         correction = build_correction_group(spec, params)
         trees = [correction, build_shader_group(spec, params, correction)]
         normal = spec.get("normal_group")
@@ -2316,6 +2319,12 @@ def result_line(payload):
     return "GLOFFUSE_RESULT " + json.dumps(payload, sort_keys=True)
 
 
+def log_step(done, total, what):
+    """Say on stdout, which gloffuse reads as the job runs, that `done` of
+    `total` steps are finished and `what` comes next."""
+    print("gloffuse step %d/%d: %s" % (done, total, what), flush=True)
+
+
 def job_is_the_program():
     """Whether this job is the program itself (python THIS.py), not code that
     another script runs in its own process (exec), whose process is not ours
@@ -2470,11 +2479,24 @@ def _set_preview(tree, path):
         bpy.ops.ed.lib_id_load_custom_preview(filepath=path)
 
 
-def render_previews(built, directory):
-    """Render a preview for every group of `built` (groups.py's build_all) with a
-    BSDF output, into `directory`, and set it as the custom preview of that
-    group and of the groups without one that belong to it (the normal group
-    gets the first view group's). Headless only."""
+def preview_groups(spec):
+    """The groups of `spec` that get a rendered preview, in order, each with the
+    helper groups that share it: [(shader group name, [helper names])]."""
+    view = spec.get("view") or {}
+    layered = spec.get("layered") or {}
+    pairs = [(spec["shader_group"], [spec["correction_group"]]),
+             (view.get("shader_group"), [view.get("correction_group")]),
+             (view.get("multiscatter_group"), []),
+             (layered.get("shader_group"), [])]
+    return [(name, helpers) for name, helpers in pairs if name]
+
+
+def render_previews(built, directory, on_preview=None):
+    """Render a preview for every group of `built` (groups.py's build_all) that
+    preview_groups names, into `directory`, and set it as the custom preview of
+    that group and of the groups without one that belong to it (the normal
+    group gets the first view group's). on_preview(tree name), if given, is
+    told before each render. Headless only."""
     images_before = {image.name for image in bpy.data.images}
     made = []
     scene, mesh = _preview_scene(made)
@@ -2482,16 +2504,12 @@ def render_previews(built, directory):
         shown = {}
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
-            view = spec.get("view") or {}
-            layered = spec.get("layered") or {}
-            pairs = [(spec["shader_group"], [spec["correction_group"]]),
-                     (view.get("shader_group"), [view.get("correction_group")]),
-                     (view.get("multiscatter_group"), []),
-                     (layered.get("shader_group"), [])]
-            for shader_name, helpers in pairs:
+            for shader_name, helpers in preview_groups(spec):
                 tree = by_name.get(shader_name)
                 if tree is None:
                     continue
+                if on_preview is not None:
+                    on_preview(tree.name)
                 path = os.path.join(directory, "preview %d.png" % len(shown))
                 _render_group(scene, mesh, tree, path, made)
                 _set_preview(tree, path)
@@ -2499,6 +2517,8 @@ def render_previews(built, directory):
                 for helper in helpers:
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
+            view = spec.get("view") or {}
+            layered = spec.get("layered") or {}
             normal = by_name.get(spec.get("normal_group"))
             first_view = view.get("shader_group") or layered.get("shader_group")
             if normal is not None and first_view in shown:
@@ -2509,7 +2529,6 @@ def render_previews(built, directory):
         for image in list(bpy.data.images):
             if image.name not in images_before and image.type in ("RENDER_RESULT", "COMPOSITING"):
                 bpy.data.images.remove(image)
-
 
 # ======== gloffuse part: generate.py ========
 # ---------------------------------------------------------------------------
@@ -2549,6 +2568,18 @@ def parse_generate_args(argv=None):
     return parse_script_args(parser, argv)
 
 
+class _Steps:
+    """The generate job's steps, told to gloffuse as each begins (log_step)."""
+
+    def __init__(self, total):
+        self.total = total
+        self.done = 0
+
+    def next(self, what):
+        log_step(self.done, self.total, what)
+        self.done += 1
+
+
 def generate_main(document_text):
     options = parse_generate_args()
     params = load_params(document_text)
@@ -2568,12 +2599,20 @@ def generate_main(document_text):
         # file's cube, camera and light.
         bpy.ops.wm.read_factory_settings(use_empty=True)
     renamed = set_aside_untagged(group_names(params))
-    built = build_all(params)
+    specs = params["groups"]
+    previews = bool(params.get("previews")) and bpy.app.background
+    steps = _Steps(len(specs) + (sum(len(preview_groups(s)) for s in specs) if previews else 0)
+                   + (1 if options.save else 0))
+    built = build_all(params, on_spec=lambda _i, spec: steps.next(
+        "building %s and its groups" % spec["shader_group"]))
     if new_library:
         mark_library(params)
-    if params.get("previews") and bpy.app.background:
+    if previews:
         with tempfile.TemporaryDirectory(prefix="gloffuse-previews-") as directory:
-            render_previews(built, directory)
+            render_previews(built, directory, on_preview=lambda name: steps.next(
+                "rendering the preview of %s" % name))
+    if options.save:
+        steps.next("saving the .blend")
     saved = save_blend(options.save, options.compress) if options.save else None
     names = []
     for _spec, trees in built:

@@ -17,6 +17,8 @@ pub trait Progress: Sync {
     fn set(&self, _done: u64) {}
     /// One more step of the current task is finished.
     fn step(&self) {}
+    /// What the current task is doing now, in place of the message it began with.
+    fn doing(&self, _what: &str) {}
     /// A task whose length is known only as it runs (a render: Cycles estimates it) starts;
     /// `estimate` follows it instead of `set` or `step`.
     fn begin_estimated(&self, _message: &str) {}

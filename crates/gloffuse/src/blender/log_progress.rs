@@ -1,11 +1,13 @@
-//! A render's progress as Cycles tells it. Blender logs a status line as the render goes
-//! ("… | Remaining:00:37.44 | … | Sample 1/128"; bpy, which logs none, has the furnace
-//! script print the same text). In the background Cycles reports only a few samples (often
-//! the first and the last), so the sample count alone would leave a bar standing still; but
-//! the first sample's line carries Cycles' own estimate of the time left, which is counted
-//! down here between lines.
+//! A run's progress as its log tells it, read while the run goes on.
+//!
+//! - A render: Blender logs Cycles' status lines ("… | Remaining:00:37.44 | … | Sample
+//!   1/128"; bpy, which logs none, has the furnace script print the same text). In the
+//!   background Cycles reports only a few samples (often the first and the last), so the
+//!   sample count alone would leave a bar standing still; but the first sample's line
+//!   carries Cycles' own estimate of the time left, which is counted down here between lines.
+//! - A job's own steps: the generate job prints "gloffuse step K/N: what" as each step
+//!   begins (runtime.py's `log_step`).
 
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -118,24 +120,74 @@ pub fn run_following_render(
     run: &Run,
     on_estimate: &(dyn Fn(Estimate) + Sync),
 ) -> Result<RunOutput, Error> {
-    let finished = AtomicBool::new(false);
     let start = Instant::now();
+    let mut seen: Option<(Status, Instant)> = None;
+    let mut shown = 0.0f64;
+    run_watching_log(run, &mut |log| {
+        let status = last_status(log);
+        if status.is_some() && status != seen.map(|(s, _)| s) {
+            seen = status.map(|s| (s, Instant::now()));
+        }
+        let since = seen.map_or(0.0, |(_, at)| at.elapsed().as_secs_f64());
+        let mut estimate = Estimate::of(seen.map(|(s, _)| s), start.elapsed().as_secs_f64(), since);
+        // A longer new estimate holds the bar rather than moving it back.
+        estimate.done = estimate.done.max(shown);
+        shown = estimate.done;
+        on_estimate(estimate);
+    })
+}
+
+/// A step a job said it began: `done` of `total` finished, `what` next.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    pub done: u64,
+    pub total: u64,
+    pub what: String,
+}
+
+const STEP_MARK: &str = "gloffuse step ";
+
+/// Every "gloffuse step K/N: what" line of `log` (each starting a line), in order.
+pub fn steps(log: &str) -> Vec<Step> {
+    log.lines()
+        .filter_map(|line| {
+            let rest = line.strip_prefix(STEP_MARK)?;
+            let (counts, what) = rest.split_once(": ")?;
+            let (done, total) = counts.split_once('/')?;
+            Some(Step {
+                done: done.parse().ok()?,
+                total: total.parse().ok()?,
+                what: what.to_string(),
+            })
+        })
+        .collect()
+}
+
+/// Runs `run` while a watcher reads its log every 200 ms and passes `on_step` each step the
+/// job says it began, in order, once (a quick step is told late rather than skipped).
+pub fn run_following_steps(
+    run: &Run,
+    on_step: &mut (dyn FnMut(&Step) + Send),
+) -> Result<RunOutput, Error> {
+    let mut told = 0;
+    run_watching_log(run, &mut |log| {
+        let all = steps(log);
+        for step in all.iter().skip(told) {
+            on_step(step);
+        }
+        told = told.max(all.len());
+    })
+}
+
+/// Runs `run` while a watcher hands `on_log` the log's text every 200 ms.
+fn run_watching_log(run: &Run, on_log: &mut (dyn FnMut(&str) + Send)) -> Result<RunOutput, Error> {
+    let finished = AtomicBool::new(false);
     std::thread::scope(|scope| {
         scope.spawn(|| {
-            let mut seen: Option<(Status, Instant)> = None;
-            let mut shown = 0.0f64;
             while !finished.load(Ordering::Relaxed) {
-                let status = read_status(&run.log);
-                if status.is_some() && status != seen.map(|(s, _)| s) {
-                    seen = status.map(|s| (s, Instant::now()));
+                if let Ok(bytes) = std::fs::read(&run.log) {
+                    on_log(&String::from_utf8_lossy(&bytes));
                 }
-                let since = seen.map_or(0.0, |(_, at)| at.elapsed().as_secs_f64());
-                let mut estimate =
-                    Estimate::of(seen.map(|(s, _)| s), start.elapsed().as_secs_f64(), since);
-                // A longer new estimate holds the bar rather than moving it back.
-                estimate.done = estimate.done.max(shown);
-                shown = estimate.done;
-                on_estimate(estimate);
                 std::thread::sleep(Duration::from_millis(200));
             }
         });
@@ -143,11 +195,6 @@ pub fn run_following_render(
         finished.store(true, Ordering::Relaxed);
         outcome
     })
-}
-
-fn read_status(log: &Path) -> Option<Status> {
-    let bytes = std::fs::read(log).ok()?;
-    last_status(&String::from_utf8_lossy(&bytes))
 }
 
 #[cfg(test)]
@@ -189,6 +236,20 @@ Fra:1 Mem:76.89M (Peak 76.89M) | Time:00:01.30 | Remaining:00:37.44 | Mem:85.08M
         let s = last_status("Remaining:soon | Sample 3/8").unwrap();
         assert_eq!((s.sample, s.samples, s.remaining), (3, 8, None));
         assert_eq!(last_status("Sample x/8"), None);
+    }
+
+    #[test]
+    fn step_lines_are_read_in_order() {
+        let log = "Info: something\ngloffuse step 0/15: building Gloffuse (GGX) and its groups\n\
+                   gloffuse step 3/15: rendering the preview of Gloffuse View (GGX)\n\
+                   Fra:1 | Sample 1/64\n";
+        let all = steps(log);
+        assert_eq!(all.len(), 2);
+        assert_eq!((all[1].done, all[1].total), (3, 15));
+        assert_eq!(all[1].what, "rendering the preview of Gloffuse View (GGX)");
+        // Only a line that starts with the mark; counts must be numbers.
+        assert_eq!(steps("Info: gloffuse step 1/2: x\n"), []);
+        assert_eq!(steps("gloffuse step a/2: x\n"), []);
     }
 
     #[test]

@@ -1,23 +1,23 @@
 //! Infrastructure: running Blender. Layered bottom-up: `process` (spawning with process
 //! groups, timeouts and logs), `environment` (what the search reads), `probe` (is this a
 //! Blender, which version), `provision` (install bpy), `discover` (the search), `run`
-//! (a script run headless, its result line read back), `render_status` (a render's progress
+//! (a script run headless, its result line read back), `log_progress` (a run's progress
 //! from its log) and `runs` (where runs keep their files).
 
 pub mod discover;
 pub mod environment;
+pub mod log_progress;
 pub mod probe;
 pub mod process;
 pub mod provision;
-pub mod render_status;
 pub mod run;
 pub mod runs;
 
 pub use discover::{FindOptions, Need, find_blender};
+pub use log_progress::{Estimate, Step, run_following_render, run_following_steps};
 pub use probe::{Blender, BlenderKind, probe};
 pub use process::Cancel;
 pub use provision::InstallerOutput;
-pub use render_status::{Estimate, run_following_render};
 pub use run::{Run, RunOutput, command_line, run_script};
 
 use std::path::PathBuf;

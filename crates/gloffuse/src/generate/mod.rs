@@ -20,7 +20,7 @@ use serde::Serialize;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use crate::blender::{Blender, BlenderOptions, Run, command_line, run_script};
+use crate::blender::{Blender, BlenderOptions, Run, RunOutput, command_line, run_following_steps};
 use crate::error::{Error, Field, Hint};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
@@ -235,7 +235,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         .as_deref()
         .map(|into| UserBlend::open(into, Field::Into, blender.version, g.allow_downgrade))
         .transpose()?;
-    let built = run_blender(g, &blender, &script, user_blend.as_ref())?;
+    let built = run_blender(g, &blender, &script, user_blend.as_ref(), progress)?;
     out.log = Some(built.log.clone());
     out.renamed = built.renamed.clone();
     // Everything is made before anything is written: a failed run leaves no output at all,
@@ -400,6 +400,7 @@ fn run_blender(
     blender: &Blender,
     script: &str,
     user_blend: Option<&UserBlend>,
+    progress: &dyn Progress,
 ) -> Result<Built, Error> {
     let run_dir = crate::blender::runs::new_run_dir("generate")?;
     let script_path = run_dir.join("gloffuse-generate.py");
@@ -440,7 +441,7 @@ fn run_blender(
         log: log.clone(),
     };
     // A run stopped while Blender saved leaves its partial `NAME@` beside the temp name.
-    let output = run_script(&run).inspect_err(|_| remove_partial_save(&tmp))?;
+    let output = run_following(&run, progress).inspect_err(|_| remove_partial_save(&tmp))?;
     let renamed = job_report(g, &output.result)?;
     if let Some(why) = incomplete_blend(&tmp) {
         return Err(Error::Blender {
@@ -456,6 +457,23 @@ fn run_blender(
         log,
         renamed,
     })
+}
+
+/// Runs the generate job while `progress` follows the steps it says it begins (each
+/// distribution's groups, each preview, the save).
+fn run_following(run: &Run, progress: &dyn Progress) -> Result<RunOutput, Error> {
+    let version = &run.blender.version_string;
+    let mut begun = false;
+    let outcome = run_following_steps(run, &mut |step| {
+        if !begun {
+            progress.begin(&format!("Blender {version}"), step.total);
+            begun = true;
+        }
+        progress.set(step.done);
+        progress.doing(&format!("Blender {version}: {}", step.what));
+    });
+    progress.end();
+    outcome
 }
 
 /// Removes what Blender writes before renaming it to `saved` (`saved@`), if it is there.
