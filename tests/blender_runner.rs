@@ -608,7 +608,10 @@ fn a_failed_install_leaves_nothing_that_looks_valid() {
     assert!(message.contains("No matching distribution"), "{message}");
     // The pip command ran in a venv that is gone: the advice is to rerun gloffuse instead.
     assert_eq!(command, None);
-    assert!(message.contains("run this gloffuse command again"), "{message}");
+    assert!(
+        message.contains("run this gloffuse command again"),
+        "{message}"
+    );
     assert!(log.unwrap().exists());
     assert_eq!(leftovers(&cache), Vec::<String>::new());
 }

@@ -1,7 +1,11 @@
 # ---------------------------------------------------------------------------
 # gloffuse previews.py: the Asset Browser previews of the generate job. Every
 # group with a BSDF output is rendered once, on a small sphere in a studio
-# light (a sky bright above, dark below), and the picture becomes the custom
+# light (a sky bright above, dark below) with a small sun whose highlight shows
+# the distribution's lobe, in the colour its kind is for (white for the
+# corrections of a glossy surface, gold for multiscatter's tinted bounces,
+# an orange base under the layered coat), captioned with its distribution and
+# kind so that no two thumbnails look alike; the picture becomes the custom
 # preview of that group and of the helper groups it uses. Everything made for
 # the renders is removed afterwards: the saved file holds only the groups.
 #
@@ -12,8 +16,10 @@ import math
 import os
 
 import bpy
+from mathutils import Vector
 
 from .compat import (
+    compat_camera_rays_only,
     compat_disable_denoising,
     compat_disable_post_processing,
     compat_node_tree,
@@ -24,8 +30,23 @@ from .runtime import render_result_image
 
 PREVIEW_SIZE = 128
 PREVIEW_SAMPLES = 64
-PREVIEW_COLOR = (0.8, 0.8, 0.8, 1.0)
 PREVIEW_ROUGHNESS = 0.35
+# The colour each kind of group is shown in (the "Color" or "Base Color" input).
+PREVIEW_COLORS = {
+    "roughness": (0.8, 0.8, 0.8, 1.0),
+    "view": (0.8, 0.8, 0.8, 1.0),
+    "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
+    "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
+}
+DISTRIBUTION_LABELS = {"BECKMANN": "Beckmann", "GGX": "GGX",
+                       "ASHIKHMIN_SHIRLEY": "Ashikhmin-Shirley"}
+SUN_TOWARDS = (-0.55, -0.75, 0.65)  # upper left, in front: the highlight sits off centre
+SUN_STRENGTH = 3.0
+SUN_ANGLE_DEGREES = 4.0
+SPHERE_RADIUS = 0.8
+SPHERE_HEIGHT = 0.3  # above the centre, leaving room for the caption below
+CAPTION_SIZE = 0.26
+CAPTION_TOP = -0.62
 
 
 def _studio_world():
@@ -38,8 +59,8 @@ def _studio_world():
     ramp = tree.nodes.new("ShaderNodeMapRange")
     ramp.inputs["From Min"].default_value = -1.0
     ramp.inputs["From Max"].default_value = 1.0
-    ramp.inputs["To Min"].default_value = 0.05
-    ramp.inputs["To Max"].default_value = 1.5
+    ramp.inputs["To Min"].default_value = 0.03
+    ramp.inputs["To Max"].default_value = 0.9
     tree.links.new(split.outputs["Z"], ramp.inputs["Value"])
     background = tree.nodes.new("ShaderNodeBackground")
     tree.links.new(ramp.outputs["Result"], background.inputs["Strength"])
@@ -72,14 +93,58 @@ def _preview_scene(made):
     scene.collection.objects.link(camera)
     scene.camera = camera
     made.extend([camera, camera_data])
-    mesh = sphere_mesh("gloffuse preview sphere", 1.0, 64, 32)
+    sun_data = bpy.data.lights.new("gloffuse preview sun", "SUN")
+    sun_data.energy = SUN_STRENGTH
+    sun_data.angle = math.radians(SUN_ANGLE_DEGREES)
+    sun = bpy.data.objects.new("gloffuse preview sun", sun_data)
+    sun.rotation_mode = "QUATERNION"
+    # A sun shines along its -Z: its +Z points at where the light comes from.
+    sun.rotation_quaternion = Vector(SUN_TOWARDS).to_track_quat("Z", "Y")
+    scene.collection.objects.link(sun)
+    made.extend([sun, sun_data])
+    mesh = sphere_mesh("gloffuse preview sphere", SPHERE_RADIUS, 64, 32)
     sphere = bpy.data.objects.new("gloffuse preview sphere", mesh)
+    sphere.location = (0.0, 0.0, SPHERE_HEIGHT)
     scene.collection.objects.link(sphere)
     made.extend([sphere, mesh])
-    return scene, mesh
+    caption = _caption_object(made)
+    scene.collection.objects.link(caption)
+    return scene, mesh, caption.data
 
 
-def _render_group(scene, mesh, tree, path, made):
+def _caption_object(made):
+    """A centred text object facing the camera below the sphere, in a flat light
+    grey seen by the camera only; its text is set per preview."""
+    curve = bpy.data.curves.new("gloffuse preview caption", "FONT")
+    curve.align_x = "CENTER"
+    curve.align_y = "TOP"
+    curve.size = CAPTION_SIZE
+    caption = bpy.data.objects.new("gloffuse preview caption", curve)
+    caption.location = (0.0, -1.5, CAPTION_TOP)
+    caption.rotation_euler = (math.radians(90.0), 0.0, 0.0)
+    material = bpy.data.materials.new("gloffuse preview caption")
+    tree = compat_node_tree(material)
+    tree.nodes.clear()
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (0.85, 0.85, 0.85, 1.0)
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(emission.outputs["Emission"], output.inputs["Surface"])
+    curve.materials.append(material)
+    compat_camera_rays_only(caption)
+    made.extend([caption, curve, material])
+    return caption
+
+
+def preview_caption(spec, kind):
+    """The two lines under a preview: the distribution (and engine, for EEVEE's
+    groups) and the kind of group."""
+    first = DISTRIBUTION_LABELS.get(spec["distribution"], spec["distribution"])
+    if spec.get("engine") == "eevee":
+        first += " EEVEE"
+    return "%s\n%s" % (first, kind)
+
+
+def _render_group(scene, mesh, tree, color, path, made):
     material = bpy.data.materials.new("gloffuse preview " + tree.name)
     made.append(material)
     node_tree = compat_node_tree(material)
@@ -87,7 +152,7 @@ def _render_group(scene, mesh, tree, path, made):
     group = node_tree.nodes.new("ShaderNodeGroup")
     group.node_tree = tree
     color_input = "Color" if "Color" in group.inputs else "Base Color"  # layered groups
-    group.inputs[color_input].default_value = PREVIEW_COLOR
+    group.inputs[color_input].default_value = color
     group.inputs["Roughness"].default_value = PREVIEW_ROUGHNESS
     output = node_tree.nodes.new("ShaderNodeOutputMaterial")
     node_tree.links.new(group.outputs["BSDF"], output.inputs["Surface"])
@@ -103,15 +168,16 @@ def _set_preview(tree, path):
 
 
 def preview_groups(spec):
-    """The groups of `spec` that get a rendered preview, in order, each with the
-    helper groups that share it: [(shader group name, [helper names])]."""
+    """The groups of `spec` that get a rendered preview, in order, each with its
+    kind and the helper groups that share it: [(shader group name, kind,
+    [helper names])]."""
     view = spec.get("view") or {}
     layered = spec.get("layered") or {}
-    pairs = [(spec["shader_group"], [spec["correction_group"]]),
-             (view.get("shader_group"), [view.get("correction_group")]),
-             (view.get("multiscatter_group"), []),
-             (layered.get("shader_group"), [])]
-    return [(name, helpers) for name, helpers in pairs if name]
+    groups = [(spec["shader_group"], "roughness", [spec["correction_group"]]),
+              (view.get("shader_group"), "view", [view.get("correction_group")]),
+              (view.get("multiscatter_group"), "multiscatter", []),
+              (layered.get("shader_group"), "layered", [])]
+    return [(name, kind, helpers) for name, kind, helpers in groups if name]
 
 
 def render_previews(built, directory, on_preview=None):
@@ -121,20 +187,22 @@ def render_previews(built, directory, on_preview=None):
     group gets the first view group's). on_preview(tree name), if given, is
     told before each render. Headless only."""
     images_before = {image.name for image in bpy.data.images}
+    fonts_before = {font.name for font in bpy.data.fonts}
     made = []
-    scene, mesh = _preview_scene(made)
+    scene, mesh, caption = _preview_scene(made)
     try:
         shown = {}
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
-            for shader_name, helpers in preview_groups(spec):
+            for shader_name, kind, helpers in preview_groups(spec):
                 tree = by_name.get(shader_name)
                 if tree is None:
                     continue
                 if on_preview is not None:
                     on_preview(tree.name)
                 path = os.path.join(directory, "preview %d.png" % len(shown))
-                _render_group(scene, mesh, tree, path, made)
+                caption.body = preview_caption(spec, kind)
+                _render_group(scene, mesh, tree, PREVIEW_COLORS[kind], path, made)
                 _set_preview(tree, path)
                 shown[tree.name] = path
                 for helper in helpers:
@@ -152,3 +220,6 @@ def render_previews(built, directory, on_preview=None):
         for image in list(bpy.data.images):
             if image.name not in images_before and image.type in ("RENDER_RESULT", "COMPOSITING"):
                 bpy.data.images.remove(image)
+        for font in list(bpy.data.fonts):
+            if font.name not in fonts_before:  # the built-in font the captions loaded
+                bpy.data.fonts.remove(font)
