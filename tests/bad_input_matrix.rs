@@ -1,7 +1,7 @@
 //! Bad input through the real `gloffuse` binary: one table, one row per mistake a user can
 //! make with a flag or an input file, for every command.
 //!
-//! Exit codes (README, "Exit codes"):
+//! Exit codes (docs/GUIDE.md, "Exit codes"):
 //! - 0: success;
 //! - 1: a check failed (`verify` or `refresh` found a sphere outside the tolerance);
 //! - 2: bad input (a flag value, a coefficients file, an output path), or Blender could not

@@ -5,7 +5,7 @@
 //! with a result line but writes nothing, (e) writes a truncated file, or that (f) reports
 //! Blender 2.79.
 //!
-//! Every one must end in exit code 2 (README: "Blender could not be found, crashed, timed
+//! Every one must end in exit code 2 (docs/GUIDE.md: "Blender could not be found, crashed, timed
 //! out or wrote nothing"), with a message that says what went wrong and, for a run, names
 //! its log (kept with the script in the run directory under `$XDG_CACHE_HOME/gloffuse/runs`,
 //! a temporary directory here) and the command to rerun it; no panic; and no output: neither

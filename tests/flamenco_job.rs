@@ -1,7 +1,7 @@
 //! The Flamenco job type (`contrib/flamenco/gloffuse-audit.js`): its own Node tests (the task
 //! graph its `compileJob` builds, against a recording stand-in for Flamenco's `author`), and
 //! the commands it builds, given to the real `gloffuse`, which must accept every flag (no
-//! Flamenco farm runs here: the README says so).
+//! Flamenco farm runs here: docs/GUIDE.md says so).
 
 mod common;
 

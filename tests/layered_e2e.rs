@@ -54,7 +54,7 @@ fn a_white_layered_sphere_reflects_everything_and_the_mix_shader_is_predicted() 
             );
         }
         // The hand-made Mix Shader loses energy where the layered group does not: GGX at
-        // IOR 2, r = 1 renders about 91 % (see the README's table).
+        // IOR 2, r = 1 renders about 91 % (see docs/RESULTS.md's layered table).
         let ggx = rows
             .iter()
             .find(|r| r["distribution"] == "ggx" && r["ior"] == 2.0 && r["roughness"] == 1.0)

@@ -702,7 +702,7 @@ fn eevee_view_groups_follow_eevee_on_a_normal_mapped_sphere() {
     }
 }
 
-/// The measurement behind the README's lit-scene table (not part of the suite: about ten
+/// The measurement behind docs/RESULTS.md's lit-scene table (not part of the suite: about ten
 /// minutes): `cargo test --release --test materials_e2e lit_scenes_table -- --ignored
 /// --nocapture`. Scenes (a) white sky, white base; (b) white sky, base (0.8, 0.3, 0.1),
 /// Noise → Bump strength 1; (c) sky + sun, white base; (d) sky + sun, that base, bump 0.5.

@@ -6,7 +6,7 @@
 //! nothing extra) and (2) the φh range is cut exactly where the reflected direction crosses
 //! the horizon (`cos φ = −cot θo · cot 2θh`). What is left converges geometrically, so a few
 //! hundred evaluations per (μ, r) reach 1e-5, where QMC with visible-normal sampling needs
-//! far more (see `README.md` for the measured comparison).
+//! far more (see `docs/RESULTS.md` for the measured comparison).
 
 use gauss_quad::legendre::GaussLegendre;
 use rayon::prelude::*;

@@ -434,7 +434,7 @@ impl Coefficients {
 pub const INTEGRATOR_POINTS: usize = 201;
 
 /// The degree of a fit to the integrator: the lowest that keeps every distribution's gain
-/// within 0.1 % of 1/E_avg (measured; see README, "Why degree 6").
+/// within 0.1 % of 1/E_avg (measured; see docs/RESULTS.md, "Coefficients: why degree 6").
 pub const INTEGRATOR_DEGREE: usize = 6;
 
 /// How [`Coefficients::fit`] fits every distribution, and what the file records about it.

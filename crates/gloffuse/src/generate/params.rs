@@ -527,7 +527,7 @@ pub fn in_eevee(d: Distribution, masking: Masking) -> [f64; 4] {
     }
 }
 
-/// What a group does in the engine it is not calibrated for, as measured (README, "EEVEE").
+/// What a group does in the engine it is not calibrated for, as measured (docs/RESULTS.md, "EEVEE").
 fn in_the_other_engine(engine: Engine, d: Distribution, masking: Masking) -> String {
     match engine {
         Engine::Eevee => "In Cycles use the groups without EEVEE in their names.".into(),
