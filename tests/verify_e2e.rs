@@ -428,6 +428,19 @@ fn column_labels_sit_over_the_cells(path: &std::path::Path) {
         "{lit} text pixels over the first column of {}",
         path.display()
     );
+    // The lines over the cells fit: none reaches the picture's right margin (a two-column
+    // sweep is narrower than its scope line).
+    let margin = image.width() - 8..image.width();
+    let at_edge = (0..top.saturating_sub(20))
+        .flat_map(|y| margin.clone().map(move |x| (x, y)))
+        .filter(|&(x, y)| image.get_pixel(x, y).0[1] > 150)
+        .count();
+    assert_eq!(
+        at_edge,
+        0,
+        "text runs into the right margin of {}",
+        path.display()
+    );
 }
 
 fn label(distribution: &Value) -> &'static str {

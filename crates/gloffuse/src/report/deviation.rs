@@ -156,7 +156,15 @@ impl Layout {
             );
         }
         let left = label_w as usize + 2 * PAD;
-        let width = (left + columns * (cell + GAP) + PAD).max(640);
+        // As wide as the cells, and as the lines over them: a narrow sweep's title and scope
+        // line would otherwise run off the picture.
+        let mut text_w = 0;
+        for (text, px) in title_lines(report) {
+            text_w = text_w.max(text_size(&text, px).map_err(|e| write_error(out, e))?.0);
+        }
+        let width = (left + columns * (cell + GAP) + PAD)
+            .max(text_w as usize + 2 * PAD)
+            .max(640);
         let height = top + series.len() * (cell + GAP) + LEGEND_H;
         let bar = (PAD + 60, width - 2 * PAD - 120, height - LEGEND_H + 10, 14);
         Ok(Layout {
@@ -218,6 +226,22 @@ fn paint_colour_bar(rgb: &mut [u8], layout: &Layout) {
     }
 }
 
+/// The lines over the cells, each with its text size: the title, the subtitle and, in
+/// roughness mode, what the mode judges.
+fn title_lines(report: &VerifyReport) -> Vec<(String, f64)> {
+    let mut lines = vec![
+        (
+            "Corrected spheres: each pixel against what the correction promises".to_string(),
+            16.0,
+        ),
+        (subtitle(report), 12.0),
+    ];
+    if !report.mode.per_pixel() {
+        lines.push((words::ROUGHNESS_PICTURE.to_string(), 12.0));
+    }
+    lines
+}
+
 /// The title, the series labels and the scale's labels.
 fn draw_text(
     rgb: &mut [u8],
@@ -235,15 +259,8 @@ fn draw_text(
     };
     let left_mid = Pos::new(HPos::Left, VPos::Center);
     let right_mid = Pos::new(HPos::Right, VPos::Center);
-    draw(
-        "Corrected spheres: each pixel against what the correction promises",
-        16.0,
-        left_mid,
-        (PAD, 16),
-    )?;
-    draw(&subtitle(report), 12.0, left_mid, (PAD, 38))?;
-    if !report.mode.per_pixel() {
-        draw(words::ROUGHNESS_PICTURE, 12.0, left_mid, (PAD, TITLE_H + 2))?;
+    for ((text, px), y) in title_lines(report).iter().zip([16, 38, TITLE_H + 2]) {
+        draw(text, *px, left_mid, (PAD, y))?;
     }
     let bottom_centre = Pos::new(HPos::Center, VPos::Bottom);
     for (j, label) in layout.column_labels.iter().enumerate() {
