@@ -179,20 +179,25 @@ pub fn run_following_steps(
     })
 }
 
-/// Runs `run` while a watcher hands `on_log` the log's text every 200 ms.
+/// Runs `run` while a watcher hands `on_log` the log's text every 200 ms, and once more
+/// when the run has ended, so that what it logged last is read too.
 fn run_watching_log(run: &Run, on_log: &mut (dyn FnMut(&str) + Send)) -> Result<RunOutput, Error> {
     let finished = AtomicBool::new(false);
     std::thread::scope(|scope| {
         scope.spawn(|| {
-            while !finished.load(Ordering::Relaxed) {
+            loop {
+                let last = finished.load(Ordering::Acquire);
                 if let Ok(bytes) = std::fs::read(&run.log) {
                     on_log(&String::from_utf8_lossy(&bytes));
+                }
+                if last {
+                    break;
                 }
                 std::thread::sleep(Duration::from_millis(200));
             }
         });
         let outcome = run_script(run);
-        finished.store(true, Ordering::Relaxed);
+        finished.store(true, Ordering::Release);
         outcome
     })
 }
