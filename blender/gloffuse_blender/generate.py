@@ -86,7 +86,7 @@ def generate_main(document_text):
     previews = bool(params.get("previews")) and bpy.app.background
     steps = _Steps(len(specs) + (sum(len(preview_groups(s)) for s in specs) if previews else 0)
                    + (1 if options.save else 0))
-    built = build_all(params, on_spec=lambda _i, spec: steps.next(
+    built = build_all(params, on_spec=lambda spec: steps.next(
         "building %s and its groups" % spec["shader_group"]))
     if new_library:
         mark_library(params)

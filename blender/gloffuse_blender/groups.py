@@ -41,14 +41,14 @@ def build_all(params, on_spec=None):
     with spec["layered"] the layered group, after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
-    with the first spec that uses it. on_spec(index, spec), if given, is told
-    before each spec is built."""
+    with the first spec that uses it. on_spec(spec), if given, is told before
+    each spec is built."""
     validate_params(params)
     built = []
     normal_names = set()
-    for index, spec in enumerate(params["groups"]):
+    for spec in params["groups"]:
         if on_spec is not None:
-            on_spec(index, spec)
+            on_spec(spec)
         correction = build_correction_group(spec, params)
         trees = [correction, build_shader_group(spec, params, correction)]
         normal = spec.get("normal_group")

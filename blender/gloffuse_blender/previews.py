@@ -38,8 +38,6 @@ PREVIEW_COLORS = {
     "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
     "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
 }
-DISTRIBUTION_LABELS = {"BECKMANN": "Beckmann", "GGX": "GGX",
-                       "ASHIKHMIN_SHIRLEY": "Ashikhmin-Shirley"}
 SUN_TOWARDS = (-0.55, -0.75, 0.65)  # upper left, in front: the highlight sits off centre
 SUN_STRENGTH = 3.0
 SUN_ANGLE_DEGREES = 4.0
@@ -137,8 +135,10 @@ def _caption_object(made):
 
 def preview_caption(spec, kind):
     """The two lines under a preview: the distribution (and engine, for EEVEE's
-    groups) and the kind of group."""
-    first = DISTRIBUTION_LABELS.get(spec["distribution"], spec["distribution"])
+    groups) and the kind of group. The distribution is spelled as the group
+    names spell it: "Gloffuse (Ashikhmin-Shirley)"."""
+    name = spec["shader_group"]
+    first = name[name.rindex("(") + 1:name.rindex(")")]
     if spec.get("engine") == "eevee":
         first += " EEVEE"
     return "%s\n%s" % (first, kind)

@@ -2135,14 +2135,14 @@ def build_all(params, on_spec=None):
     with spec["layered"] the layered group, after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
-    with the first spec that uses it. on_spec(index, spec), if given, is told
-    before each spec is built."""
+    with the first spec that uses it. on_spec(spec), if given, is told before
+    each spec is built."""
     validate_params(params)
     built = []
     normal_names = set()
-    for index, spec in enumerate(params["groups"]):
+    for spec in params["groups"]:
         if on_spec is not None:
-            on_spec(index, spec)
+            on_spec(spec)
         correction = build_correction_group(spec, params)
         trees = [correction, build_shader_group(spec, params, correction)]
         normal = spec.get("normal_group")
@@ -2414,8 +2414,6 @@ PREVIEW_COLORS = {
     "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
     "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
 }
-DISTRIBUTION_LABELS = {"BECKMANN": "Beckmann", "GGX": "GGX",
-                       "ASHIKHMIN_SHIRLEY": "Ashikhmin-Shirley"}
 SUN_TOWARDS = (-0.55, -0.75, 0.65)  # upper left, in front: the highlight sits off centre
 SUN_STRENGTH = 3.0
 SUN_ANGLE_DEGREES = 4.0
@@ -2513,8 +2511,10 @@ def _caption_object(made):
 
 def preview_caption(spec, kind):
     """The two lines under a preview: the distribution (and engine, for EEVEE's
-    groups) and the kind of group."""
-    first = DISTRIBUTION_LABELS.get(spec["distribution"], spec["distribution"])
+    groups) and the kind of group. The distribution is spelled as the group
+    names spell it: "Gloffuse (Ashikhmin-Shirley)"."""
+    name = spec["shader_group"]
+    first = name[name.rindex("(") + 1:name.rindex(")")]
     if spec.get("engine") == "eevee":
         first += " EEVEE"
     return "%s\n%s" % (first, kind)
@@ -2673,7 +2673,7 @@ def generate_main(document_text):
     previews = bool(params.get("previews")) and bpy.app.background
     steps = _Steps(len(specs) + (sum(len(preview_groups(s)) for s in specs) if previews else 0)
                    + (1 if options.save else 0))
-    built = build_all(params, on_spec=lambda _i, spec: steps.next(
+    built = build_all(params, on_spec=lambda spec: steps.next(
         "building %s and its groups" % spec["shader_group"]))
     if new_library:
         mark_library(params)
