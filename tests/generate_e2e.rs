@@ -108,6 +108,12 @@ fn previews_tell_groups_apart(label: &str, dir: &std::path::Path) {
     assert_eq!(groups.len(), 9, "Blender {label}: {groups:?}");
     let images: Vec<_> = groups.iter().map(|g| preview(dir, g)).collect();
     let height = images[0].height();
+    // Nothing is cut off at the sides: the outer columns stay transparent.
+    for (group, image) in groups.iter().zip(&images) {
+        let edge = [0, image.width() - 1];
+        let cut = (0..height).any(|y| edge.iter().any(|&x| image.get_pixel(x, y)[3] > 0.01));
+        assert!(!cut, "Blender {label}: {group}'s preview reaches its side");
+    }
     for (i, a) in images.iter().enumerate() {
         for (j, b) in images.iter().enumerate().skip(i + 1) {
             let apart = pixels_apart(a, b, 0..height, 0.1);

@@ -134,14 +134,13 @@ def _caption_object(made):
 
 
 def preview_caption(spec, kind):
-    """The two lines under a preview: the distribution (and engine, for EEVEE's
-    groups) and the kind of group. The distribution is spelled as the group
-    names spell it: "Gloffuse (Ashikhmin-Shirley)"."""
+    """The two lines under a preview: the distribution, spelled as the group
+    names spell it ("Gloffuse (Ashikhmin-Shirley)"), then the kind of group,
+    after "EEVEE" for EEVEE's groups (the first line is as wide as fits)."""
     name = spec["shader_group"]
-    first = name[name.rindex("(") + 1:name.rindex(")")]
-    if spec.get("engine") == "eevee":
-        first += " EEVEE"
-    return "%s\n%s" % (first, kind)
+    distribution = name[name.rindex("(") + 1:name.rindex(")")]
+    engine = "EEVEE " if spec.get("engine") == "eevee" else ""
+    return "%s\n%s%s" % (distribution, engine, kind)
 
 
 def _render_group(scene, mesh, tree, color, path, made):
@@ -184,8 +183,9 @@ def render_previews(built, directory, on_preview=None):
     """Render a preview for every group of `built` (groups.py's build_all) that
     preview_groups names, into `directory`, and set it as the custom preview of
     that group and of the groups without one that belong to it (the normal
-    group gets the first view group's). on_preview(tree name), if given, is
-    told before each render. Headless only."""
+    group gets the first view, multiscatter or layered group's).
+    on_preview(tree name), if given, is told before each render. Headless
+    only."""
     images_before = {image.name for image in bpy.data.images}
     fonts_before = {font.name for font in bpy.data.fonts}
     made = []
@@ -211,7 +211,8 @@ def render_previews(built, directory, on_preview=None):
             view = spec.get("view") or {}
             layered = spec.get("layered") or {}
             normal = by_name.get(spec.get("normal_group"))
-            first_view = view.get("shader_group") or layered.get("shader_group")
+            first_view = (view.get("shader_group") or view.get("multiscatter_group")
+                          or layered.get("shader_group"))
             if normal is not None and first_view in shown:
                 _set_preview(normal, shown[first_view])
     finally:
