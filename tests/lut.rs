@@ -26,6 +26,7 @@ fn small(kind: Kind, out: &Path, format: Format, bits: Bits) -> LutOptions {
     args.size = Some(match kind {
         Kind::SplitSum => 24,
         Kind::KullaConty | Kind::Albedo | Kind::Coat => 8,
+        Kind::Anisotropic => 4,
     });
     // Only Kulla–Conty samples: the albedo and coat tables and split-sum's default method
     // are quadrature.
@@ -68,7 +69,13 @@ fn assert_same_texels(found: &[f32], table: &Table, bits: Bits, what: &str) {
     }
 }
 
-const KINDS: [Kind; 4] = [Kind::SplitSum, Kind::KullaConty, Kind::Albedo, Kind::Coat];
+const KINDS: [Kind; 5] = [
+    Kind::SplitSum,
+    Kind::KullaConty,
+    Kind::Albedo,
+    Kind::Coat,
+    Kind::Anisotropic,
+];
 const BITS: [Bits; 2] = [Bits::Half, Bits::Float];
 
 #[test]
@@ -151,10 +158,10 @@ fn dds_reads_back_with_ddsfile() {
             let summary = lut(&args, &Quiet).unwrap();
             let dds = Dds::read(std::fs::File::open(&path).unwrap()).unwrap();
             let expected = match (kind, bits) {
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Half) => {
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Half) => {
                     DxgiFormat::R16G16_Float
                 }
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Float) => {
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Float) => {
                     DxgiFormat::R32G32_Float
                 }
                 (Kind::KullaConty, Bits::Half) => DxgiFormat::R16G16B16A16_Float,
@@ -196,10 +203,10 @@ fn ktx2_reads_back_with_the_ktx2_crate() {
             let reader = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             let header = reader.header();
             let format = match (kind, bits) {
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Half) => {
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Half) => {
                     ktx2::Format::R16G16_SFLOAT
                 }
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat, Bits::Float) => {
+                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Float) => {
                     ktx2::Format::R32G32_SFLOAT
                 }
                 (Kind::KullaConty, Bits::Half) => ktx2::Format::R16G16B16A16_SFLOAT,
@@ -890,4 +897,86 @@ fn progress_counts_every_step() {
         spec.compute(&calls);
         assert_eq!(calls.0.into_inner(), spec.progress_steps(), "{kind:?}");
     }
+}
+
+#[test]
+fn anisotropic_diagonal_is_the_isotropic_albedo_table() {
+    // Where the two widths agree (rx = ry) the lobe is isotropic: every azimuth's texel must
+    // be the albedo table's E(μ, r), and G its E_avg(r), computed by the isotropic
+    // integrator (another quadrature, over the half vector's polar angle).
+    let n = 8;
+    for (d, v) in [
+        (Distribution::Ggx, "3.4".parse().unwrap()),
+        (Distribution::Beckmann, BlenderVersion::DEFAULT),
+    ] {
+        let spec = |kind| {
+            let mut args = LutOptions::new(kind, "x.exr");
+            args.size = Some(n as u32);
+            args.distribution = Some(d);
+            args.blender_version = Some(v);
+            Spec::from_options(&args).unwrap().compute(&Quiet)
+        };
+        let (aniso, albedo) = (spec(Kind::Anisotropic), spec(Kind::Albedo));
+        assert_eq!((aniso.width, aniso.height), (8 * n, n * n));
+        for l in 0..n {
+            for i in 0..n {
+                let (e, e_avg) = (albedo.get(l, i, 0), albedo.get(l, i, 1));
+                for k in 0..8 {
+                    let (x, y) = (k * n + l, l * n + i);
+                    let found = aniso.get(x, y, 0);
+                    assert!(
+                        (found - e).abs() < 2e-4,
+                        "{d} r {l} μ {i} φ {k}: {found} vs {e}"
+                    );
+                    let found_avg = aniso.get(x, y, 1);
+                    assert!(
+                        (found_avg - e_avg).abs() < 2e-4,
+                        "{d} r {l}: E_avg {found_avg} vs {e_avg}"
+                    );
+                }
+            }
+        }
+        // and off the diagonal the azimuth matters (rx = 0.0625 narrow, ry = 0.9375 wide, grazing)
+        let (j, l, i) = (0, 7, 0);
+        let along = aniso.get(j, l * n + i, 0);
+        let across = aniso.get(7 * n + j, l * n + i, 0);
+        assert!((along - across).abs() > 0.02, "{d}: {along} vs {across}");
+    }
+}
+
+#[test]
+fn anisotropic_refuses_what_blender_does_not_render() {
+    let refused = |d: Distribution, v: &str| {
+        let mut args = LutOptions::new(Kind::Anisotropic, "x.exr");
+        args.distribution = Some(d);
+        args.blender_version = Some(v.parse().unwrap());
+        Spec::from_options(&args).err()
+    };
+    // Ashikhmin–Shirley is another model; 3.4's anisotropic Beckmann samples the wrong lobe
+    // (tests/anisotropic_e2e.rs renders it).
+    assert!(matches!(
+        refused(Distribution::AshikhminShirley, "4.5"),
+        Some(Error::Input {
+            field: Field::Distribution,
+            ..
+        })
+    ));
+    assert!(matches!(
+        refused(Distribution::Beckmann, "3.4"),
+        Some(Error::Input {
+            field: Field::BlenderVersion,
+            ..
+        })
+    ));
+    assert!(refused(Distribution::Beckmann, "3.5").is_none());
+    assert!(refused(Distribution::Ggx, "3.0").is_none());
+    let mut args = LutOptions::new(Kind::Anisotropic, "x.exr");
+    args.size = Some(33);
+    assert!(matches!(
+        Spec::from_options(&args),
+        Err(Error::Input {
+            field: Field::Size,
+            ..
+        })
+    ));
 }

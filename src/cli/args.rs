@@ -263,6 +263,10 @@ const KINDS: &[Choice<Kind>] = &[
         Kind::Coat,
         "the layered shader's dielectric coat: 12 IOR slices side by side (R = A(μ, r, IOR), G = E(μ, r))",
     ),
+    choice(
+        Kind::Anisotropic,
+        "Cycles' anisotropic GGX or Beckmann lobe: 8 view azimuths × --size bitangent widths of slices (R = E(μ, φ, αx, αy), G = E_avg(αx, αy))",
+    ),
 ];
 
 const G_MODELS: &[Choice<GModel>] = &[
@@ -1025,19 +1029,19 @@ impl BenchArgs {
 /// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
 #[derive(Args, Debug, Clone, PartialEq)]
 pub struct LutArgs {
-    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G); coat: A(μ, r, IOR), E(μ, r) (R, G) in 12 slices of IOR 1 to 3 side by side.
+    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G); coat: A(μ, r, IOR), E(μ, r) (R, G) in 12 slices of IOR 1 to 3 side by side; anisotropic: E(μ, φ, αx, αy), E_avg(αx, αy) (R, G) in slices over the view azimuth and the bitangent width.
     #[arg(long, value_parser = one_of(KINDS, Kind::key), default_value = Kind::SplitSum.key())]
     pub kind: Kind,
 
-    /// kulla-conty, albedo and coat: beckmann, ggx or ashikhmin-shirley [default: ggx].
+    /// kulla-conty, albedo and coat: beckmann, ggx or ashikhmin-shirley; anisotropic: beckmann or ggx [default: ggx].
     #[arg(long, short = 'd', value_parser = parse_distribution)]
     pub distribution: Option<Distribution>,
 
-    /// kulla-conty, albedo and coat: the Blender whose masking the BSDF follows (3.0–3.4 separable, 3.5+ height-correlated) [default: 4.5].
+    /// kulla-conty, albedo, coat and anisotropic: the Blender whose masking the BSDF follows (3.0–3.4 separable, 3.5+ height-correlated) [default: 4.5].
     #[arg(long, value_parser = parse_version)]
     pub blender_version: Option<BlenderVersion>,
 
-    /// Texels per side (per slice for coat), 1 to 8192 [default: 512 for split-sum, 64 otherwise].
+    /// Texels per side (per slice for coat and anisotropic), 1 to 8192 (coat 1024, anisotropic 32) [default: 512 for split-sum, 16 for anisotropic, 64 otherwise].
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
 
@@ -1250,6 +1254,7 @@ pub fn flag(field: Field) -> String {
         Field::Timeout => "--timeout",
         Field::ViewCosine => "--mu",
         Field::Arguments
+        | Field::Anisotropy
         | Field::Catalogs
         | Field::ContactSheet
         | Field::ModelParameter(_)

@@ -129,8 +129,23 @@ pub fn lut(s: &LutSummary) -> String {
     for c in &s.channels {
         out += &format!("  {c}\n");
     }
-    match &s.ior {
-        Some(ior) => {
+    match (&s.azimuths, &s.ior) {
+        (Some(azimuths), _) => {
+            let n = s.width / azimuths.len().max(1);
+            let list: Vec<String> = azimuths
+                .iter()
+                .map(|v| format!("{:.1}°", v.to_degrees()))
+                .collect();
+            out += &format!(
+                "  {} columns × {n} rows of {n}×{n} slices; column k at view azimuth {} from the tangent\n",
+                azimuths.len(),
+                list.join(", ")
+            );
+            out += &format!(
+                "  row l at ry = (l + ½)/{n}; in a slice, texel (x, y) at rx = (x − {n}k + ½)/{n}, N·V = (y − {n}l + ½)/{n}; αx = rx², αy = ry²; first row first\n"
+            );
+        }
+        (None, Some(ior)) => {
             let n = s.height;
             let list: Vec<String> = ior.iter().map(|v| format!("{v:.3}")).collect();
             out += &format!(
@@ -142,7 +157,7 @@ pub fn lut(s: &LutSummary) -> String {
                 "  in slice k, texel (x, y) at roughness (x − {n}k + ½)/{n}, N·V (y + ½)/{n}, first row first\n"
             );
         }
-        None => {
+        (None, None) => {
             out += &format!(
                 "  uv = (roughness, N·V); texel (x, y) at ((x + ½)/{}, (y + ½)/{}), first row first\n",
                 s.width, s.height

@@ -118,6 +118,8 @@ impl Error {
 pub enum Field {
     /// The combination of inputs as a whole (none of them alone is wrong).
     Arguments,
+    /// The Anisotropy input of a Glossy BSDF.
+    Anisotropy,
     /// The Blender to run: an executable, or a Python that imports bpy.
     Blender,
     /// The Blender version whose BSDFs are modelled.
@@ -204,6 +206,7 @@ impl Field {
     pub fn name(self) -> String {
         match self {
             Field::Arguments => "arguments",
+            Field::Anisotropy => "anisotropy",
             Field::Blender => "blender",
             Field::BlenderVersion => "Blender version",
             Field::Blend => "library .blend",

@@ -58,6 +58,29 @@ impl Distribution {
     }
 }
 
+impl Distribution {
+    /// Smith's Λ as a function of `α² tan²θ`, where for an anisotropic lobe α² is the width
+    /// along the direction's azimuth, `(αx² x² + αy² y²)/(x² + y²)` (so one formula serves
+    /// both). GGX: the exact `(√(1 + α² tan²θ) − 1)/2`. Beckmann: Walter's rational
+    /// approximation, as Cycles uses it, with `a = 1/(α tanθ)`. Ashikhmin–Shirley: 0
+    /// (Cycles' version has no masking term; its `max(cosθi, cosθo)` plays that role).
+    pub fn lambda_of_alpha2_tan2(self, a2t2: f64) -> f64 {
+        match self {
+            Distribution::Ggx => ((1.0 + a2t2).sqrt() - 1.0) * 0.5,
+            Distribution::AshikhminShirley => 0.0,
+            Distribution::Beckmann => {
+                // a ≥ 1.6 ⇔ α² tan²θ ≤ 1/1.6² = 0.390625
+                if a2t2 < 0.39 {
+                    0.0
+                } else {
+                    let a = 1.0 / a2t2.sqrt();
+                    ((0.396 * a - 1.259) * a + 1.0) / ((2.181 * a + 3.535) * a)
+                }
+            }
+        }
+    }
+}
+
 impl std::fmt::Display for Distribution {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.key())
@@ -249,26 +272,11 @@ impl Microfacet {
     }
 
     /// Smith's Λ for a direction with cosine `cos_t` to the normal.
-    /// GGX: the exact `(√(1 + α² tan²θ) − 1)/2`. Beckmann: Walter's rational approximation,
-    /// as Cycles uses it, with `a = 1/(α tanθ)`. Ashikhmin–Shirley: 0 (Cycles' version has
-    /// no masking term; its `max(cosθi, cosθo)` plays that role).
     pub fn lambda(self, cos_t: f64) -> f64 {
         let c2 = cos_t * cos_t;
         let tan2 = ((1.0 - c2) / c2).max(0.0);
-        let a2t2 = self.alpha * self.alpha * tan2;
-        match self.distribution {
-            Distribution::Ggx => ((1.0 + a2t2).sqrt() - 1.0) * 0.5,
-            Distribution::AshikhminShirley => 0.0,
-            Distribution::Beckmann => {
-                // a ≥ 1.6 ⇔ α² tan²θ ≤ 1/1.6² = 0.390625
-                if a2t2 < 0.39 {
-                    0.0
-                } else {
-                    let a = 1.0 / a2t2.sqrt();
-                    ((0.396 * a - 1.259) * a + 1.0) / ((2.181 * a + 3.535) * a)
-                }
-            }
-        }
+        self.distribution
+            .lambda_of_alpha2_tan2(self.alpha * self.alpha * tan2)
     }
 
     /// Smith's masking `G1(ω) = 1 / (1 + Λ(ω))`.

@@ -1,10 +1,12 @@
 //! ① Measure: the physics. The microfacet distributions (`microfacet`), the Glossy BSDF as
-//! Cycles evaluates it (`glossy`), its albedo by quadrature (`albedo`), the masking family of
-//! each Blender version (`version`), the BSDF each render engine evaluates (`engine`), the
-//! normal a glossy BSDF shades with (`shading_normal`), the dielectric Fresnel (`fresnel`)
-//! and the coat of the layered shader (`coat`), and the classic BRDF set (`brdf`).
+//! Cycles evaluates it (`glossy`), its albedo by quadrature (`albedo`), the anisotropic lobe
+//! and its albedo (`anisotropic`), the masking family of each Blender version (`version`),
+//! the BSDF each render engine evaluates (`engine`), the normal a glossy BSDF shades with
+//! (`shading_normal`), the dielectric Fresnel (`fresnel`) and the coat of the layered shader
+//! (`coat`), and the classic BRDF set (`brdf`).
 
 pub mod albedo;
+pub mod anisotropic;
 pub mod brdf;
 pub mod coat;
 pub mod engine;
@@ -15,6 +17,7 @@ pub mod shading_normal;
 pub mod version;
 
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
+pub use anisotropic::{AnisotropicIntegrator, AnisotropicLobe, Anisotropy};
 pub use engine::Engine;
 pub use glossy::Glossy;
 pub use microfacet::{Distribution, Masking, Microfacet, Polar, Roughness};

@@ -33,6 +33,11 @@
 //!   (listed in the summary): **R = A(μ, r, η)**, the albedo of a dielectric microfacet
 //!   coat with its lost energy given back, **G = E(μ, r)**. Quadrature, no samples.
 //!
+//! * [`Kind::Anisotropic`], 2 channels, Cycles' anisotropic GGX or Beckmann lobe (see
+//!   [`anisotropic`]): an atlas of 8 view azimuths side by side × n bitangent widths
+//!   stacked, each slice n × n over (tangent width, N·V): **R = E(μ, φ, αx, αy)**,
+//!   **G = E_avg(αx, αy)**. Quadrature, no samples.
+//!
 //! # Formats
 //!
 //! * EXR (`exr` crate): one part, scan lines, ZIP compression (16 lines), channels R, G
@@ -42,6 +47,7 @@
 //! * KTX 2.0 (written here, see [`ktx2`]): VK_FORMAT_R16G16_SFLOAT / R32G32_SFLOAT or
 //!   R16G16B16A16_SFLOAT / R32G32B32A32_SFLOAT, one level, no supercompression.
 
+pub mod anisotropic;
 pub mod coat;
 pub mod dds;
 pub mod ktx2;
@@ -75,6 +81,9 @@ pub enum Kind {
     /// The layered shader's coat: slices over the index of refraction (R = A(μ, r, η),
     /// G = E(μ, r)).
     Coat,
+    /// Cycles' anisotropic lobe: slices over the view azimuth and the bitangent width
+    /// (R = E(μ, φ, αx, αy), G = E_avg(αx, αy)).
+    Anisotropic,
 }
 
 impl Kind {
@@ -84,6 +93,7 @@ impl Kind {
             Kind::KullaConty => "kulla-conty",
             Kind::Albedo => "albedo",
             Kind::Coat => "coat",
+            Kind::Anisotropic => "anisotropic",
         }
     }
 }
@@ -288,6 +298,11 @@ pub enum Spec {
         distribution: Distribution,
         blender_version: BlenderVersion,
     },
+    Anisotropic {
+        size: usize,
+        distribution: Distribution,
+        blender_version: BlenderVersion,
+    },
 }
 
 impl Spec {
@@ -325,15 +340,45 @@ impl Spec {
                     blender_version,
                 })
             }
+            Kind::Anisotropic => {
+                reject_split_sum_flags(args)?;
+                reject_samples(args)?;
+                if distribution == Distribution::AshikhminShirley {
+                    return Err(Error::input(
+                        Field::Distribution,
+                        distribution.key(),
+                        Hint::new(
+                            "ggx or beckmann with {} anisotropic (the table covers the two microfacet distributions)",
+                            [Field::Kind],
+                        ),
+                    ));
+                }
+                if !blender_version.renders_anisotropic(distribution) {
+                    return Err(Error::input(
+                        Field::BlenderVersion,
+                        blender_version,
+                        Hint::new(
+                            "3.5 or later with {} beckmann {} anisotropic (Blender 3.0–3.4 sample an isotropic lobe for anisotropic Beckmann, so they do not render the lobe this table describes; GGX is right in every version)",
+                            [Field::Distribution, Field::Kind],
+                        ),
+                    ));
+                }
+                Ok(Spec::Anisotropic {
+                    size,
+                    distribution,
+                    blender_version,
+                })
+            }
         }
     }
 
     /// How many times [`Spec::compute`] steps its `progress`.
     pub fn progress_steps(&self) -> usize {
         match *self {
-            Spec::SplitSum { size, .. } | Spec::Albedo { size, .. } | Spec::Coat { size, .. } => {
-                size
-            }
+            Spec::SplitSum { size, .. }
+            | Spec::Albedo { size, .. }
+            | Spec::Coat { size, .. }
+            | Spec::Anisotropic { size, .. } => size,
             Spec::KullaConty { size, .. } => 2 * size,
         }
     }
@@ -374,6 +419,16 @@ impl Spec {
                 distribution,
                 blender_version,
             } => coat::coat_table(size, distribution, blender_version.masking(), progress),
+            Spec::Anisotropic {
+                size,
+                distribution,
+                blender_version,
+            } => anisotropic::anisotropic_table(
+                size,
+                distribution,
+                blender_version.masking(),
+                progress,
+            ),
         }
     }
 }
@@ -385,6 +440,7 @@ fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
         Kind::SplitSum => (512, 2048),
         Kind::KullaConty => (64, 4096),
         Kind::Albedo | Kind::Coat => (64, 1),
+        Kind::Anisotropic => (16, 1),
     };
     let size = args.size.unwrap_or(default_size);
     let samples = args.samples.unwrap_or(default_samples);
@@ -411,6 +467,20 @@ fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
                     "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
                     coat::MAX_SIZE,
                     crate::measure::coat::SLICES
+                ),
+                [Field::Kind],
+            ),
+        ));
+    }
+    if args.kind == Kind::Anisotropic && size > anisotropic::MAX_SIZE {
+        return Err(Error::input(
+            Field::Size,
+            size,
+            Hint::new(
+                format!(
+                    "texels per slice side from 1 to {} for {{}} anisotropic (its atlas holds {} × size slices of size² albedos, each a 9,216-point quadrature)",
+                    anisotropic::MAX_SIZE,
+                    anisotropic::AZIMUTHS
                 ),
                 [Field::Kind],
             ),
@@ -548,6 +618,9 @@ pub struct LutSummary {
     /// coat: the index of refraction of each slice, in order.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ior: Option<Vec<f64>>,
+    /// anisotropic: the view azimuth (radians from the tangent) of each column of slices.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub azimuths: Option<Vec<f64>>,
     /// Size of the written file.
     pub bytes: usize,
     /// Wall-clock seconds spent computing the table (excluding encoding and writing).
@@ -597,6 +670,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         distribution: settings.distribution,
         blender_version: settings.blender_version,
         ior: matches!(spec, Spec::Coat { .. }).then(coat::ior),
+        azimuths: matches!(spec, Spec::Anisotropic { .. }).then(anisotropic::azimuths),
         bytes: bytes.len(),
         compute_seconds,
         seconds: start.elapsed().as_secs_f64(),
@@ -665,6 +739,11 @@ impl Settings {
                 distribution,
                 blender_version,
                 ..
+            }
+            | Spec::Anisotropic {
+                distribution,
+                blender_version,
+                ..
             } => Settings::blender(distribution, blender_version),
         }
     }
@@ -694,6 +773,10 @@ impl Spec {
             ],
             Spec::Coat { .. } => &["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
             Spec::Albedo { .. } => &["R: E(μ, r)", "G: E_avg(r)"],
+            Spec::Anisotropic { .. } => &[
+                "R: E(μ, φ of the slice's column, αx = rx², αy = ry² of the slice's row)",
+                "G: E_avg(αx, αy)",
+            ],
         }
     }
 }

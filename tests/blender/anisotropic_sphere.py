@@ -1,0 +1,103 @@
+# ---------------------------------------------------------------------------
+# anisotropic_sphere.py: renders white furnace spheres with Blender's own
+# anisotropic glossy BSDF, for tests/anisotropic_e2e.rs to compare with the
+# integrator pixel by pixel.
+#
+#     anisotropic_sphere.py CASES.json OUT.json
+#
+# CASES.json: {"px": N, "samples": S, "cases": [{"distribution": "GGX",
+# "roughness": r, "anisotropy": a}, ...]}. Each case is a unit sphere (smooth
+# UV sphere) at the origin, an orthographic camera on -Y looking along +Y with
+# ortho scale 2 (pixel (col, row) sees x = (col + 1/2)/N * 2 - 1, z likewise,
+# bottom row first), a white world of strength 1, and a point-like pixel
+# filter. The BSDF is 3.x's Anisotropic BSDF or 4.x/5.x's Glossy BSDF (its
+# Anisotropy input) with the tangent of a Tangent node (radial about Z), as
+# Cycles builds it when nothing is linked. OUT.json gets {"px": N, "renders":
+# [[R of every pixel, bottom row first], ...]}.
+# ---------------------------------------------------------------------------
+import json
+import math
+import os
+import sys
+import tempfile
+
+import bpy
+
+
+def anisotropic_material(case):
+    material = bpy.data.materials.new("anisotropic")
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    nodes.clear()
+    output = nodes.new("ShaderNodeOutputMaterial")
+    kind = "ShaderNodeBsdfGlossy" if bpy.app.version >= (4, 0, 0) else "ShaderNodeBsdfAnisotropic"
+    bsdf = nodes.new(kind)
+    bsdf.distribution = case["distribution"]
+    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    bsdf.inputs["Roughness"].default_value = case["roughness"]
+    bsdf.inputs["Anisotropy"].default_value = case["anisotropy"]
+    tangent = nodes.new("ShaderNodeTangent")
+    tangent.direction_type = "RADIAL"
+    tangent.axis = "Z"
+    links.new(tangent.outputs["Tangent"], bsdf.inputs["Tangent"])
+    links.new(bsdf.outputs[0], output.inputs["Surface"])
+    return material
+
+
+def build_scene(px, samples):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
+    sphere = bpy.context.object
+    mesh = sphere.data
+    for polygon in mesh.polygons:
+        polygon.use_smooth = True
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2.0
+    camera.location = (0.0, -5.0, 0.0)
+    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    world = bpy.data.worlds.new("white")
+    world.use_nodes = True
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    scene.world = world
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.filter_width = 0.01
+    scene.render.resolution_x = scene.render.resolution_y = px
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    return scene, sphere
+
+
+def main(argv):
+    with open(argv[0], encoding="utf-8") as handle:
+        request = json.load(handle)
+    px = int(request["px"])
+    scene, sphere = build_scene(px, int(request["samples"]))
+    renders = []
+    with tempfile.TemporaryDirectory() as folder:
+        for index, case in enumerate(request["cases"]):
+            sphere.data.materials.clear()
+            sphere.data.materials.append(anisotropic_material(case))
+            scene.render.filepath = os.path.join(folder, "case%d.exr" % index)
+            bpy.ops.render.render(write_still=True)
+            image = bpy.data.images.load(scene.render.filepath)
+            pixels = list(image.pixels[:])
+            renders.append(pixels[0::4])
+            bpy.data.images.remove(image)
+    with open(argv[1], "w", encoding="utf-8") as handle:
+        json.dump({"px": px, "renders": renders}, handle)
+    print("GLOFFUSE_RESULT rendered %d spheres" % len(renders))
+
+
+if __name__ == "__main__":
+    main(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:])
