@@ -900,46 +900,57 @@ fn progress_counts_every_step() {
 }
 
 #[test]
-fn anisotropic_diagonal_is_the_isotropic_albedo_table() {
+fn anisotropic_diagonal_is_the_isotropic_albedo() {
     // Where the two widths agree (rx = ry) the lobe is isotropic: every azimuth's texel must
-    // be the albedo table's E(μ, r), and G its E_avg(r), computed by the isotropic
-    // integrator (another quadrature, over the half vector's polar angle).
+    // be E(μ, r), and G E_avg(r), of the isotropic integrator (another quadrature, over the
+    // half vector's polar angle), at the table's grid points.
     let n = 8;
+    let q = AlbedoIntegrator::default();
     for (d, v) in [
-        (Distribution::Ggx, "3.4".parse().unwrap()),
+        (Distribution::Ggx, "3.4".parse::<BlenderVersion>().unwrap()),
         (Distribution::Beckmann, BlenderVersion::DEFAULT),
     ] {
-        let spec = |kind| {
-            let mut args = LutOptions::new(kind, "x.exr");
-            args.size = Some(n as u32);
-            args.distribution = Some(d);
-            args.blender_version = Some(v);
-            Spec::from_options(&args).unwrap().compute(&Quiet)
-        };
-        let (aniso, albedo) = (spec(Kind::Anisotropic), spec(Kind::Albedo));
-        assert_eq!((aniso.width, aniso.height), (8 * n, n * n));
+        let mut args = LutOptions::new(Kind::Anisotropic, "x.exr");
+        args.size = Some(n as u32);
+        args.distribution = Some(d);
+        args.blender_version = Some(v);
+        let aniso = Spec::from_options(&args).unwrap().compute(&Quiet);
+        assert_eq!((aniso.width, aniso.height), (16 * n, n * n));
         for l in 0..n {
+            let r = (l as f64 / (n - 1) as f64).max(0.01);
+            let g = Glossy::new(d, v.masking(), Roughness::new(r).unwrap());
+            let e_avg = if r.powi(4) <= 1e-7 {
+                1.0
+            } else {
+                q.average_albedo(&g)
+            };
             for i in 0..n {
-                let (e, e_avg) = (albedo.get(l, i, 0), albedo.get(l, i, 1));
-                for k in 0..8 {
+                let mu = (i as f64 / (n - 1) as f64).max(1e-3);
+                // Cycles renders α² ≤ 1e-7 (r = 0.01 here) as a mirror: albedo 1.
+                let e = if r.powi(4) <= 1e-7 {
+                    1.0
+                } else {
+                    q.directional_albedo(&g, mu)
+                };
+                for k in 0..16 {
                     let (x, y) = (k * n + l, l * n + i);
-                    let found = aniso.get(x, y, 0);
+                    let found = f64::from(aniso.get(x, y, 0));
                     assert!(
                         (found - e).abs() < 2e-4,
-                        "{d} r {l} μ {i} φ {k}: {found} vs {e}"
+                        "{d} r {r} μ {mu} φ {k}: {found} vs {e}"
                     );
-                    let found_avg = aniso.get(x, y, 1);
+                    let found_avg = f64::from(aniso.get(x, y, 1));
                     assert!(
                         (found_avg - e_avg).abs() < 2e-4,
-                        "{d} r {l}: E_avg {found_avg} vs {e_avg}"
+                        "{d} r {r}: E_avg {found_avg} vs {e_avg}"
                     );
                 }
             }
         }
-        // and off the diagonal the azimuth matters (rx = 0.0625 narrow, ry = 0.9375 wide, grazing)
-        let (j, l, i) = (0, 7, 0);
+        // and off the diagonal the azimuth matters (rx = 1/7 narrow, ry = 1 wide, grazing)
+        let (j, l, i) = (1, n - 1, 1);
         let along = aniso.get(j, l * n + i, 0);
-        let across = aniso.get(7 * n + j, l * n + i, 0);
+        let across = aniso.get(15 * n + j, l * n + i, 0);
         assert!((along - across).abs() > 0.02, "{d}: {along} vs {across}");
     }
 }

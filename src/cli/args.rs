@@ -265,7 +265,7 @@ const KINDS: &[Choice<Kind>] = &[
     ),
     choice(
         Kind::Anisotropic,
-        "Cycles' anisotropic GGX or Beckmann lobe: 8 view azimuths × --size bitangent widths of slices (R = E(μ, φ, αx, αy), G = E_avg(αx, αy))",
+        "Cycles' anisotropic GGX or Beckmann lobe: 16 view azimuths × --size bitangent widths of slices at grid points (R = E(μ, φ, αx, αy), G = E_avg(αx, αy))",
     ),
 ];
 
@@ -1041,7 +1041,7 @@ pub struct LutArgs {
     #[arg(long, value_parser = parse_version)]
     pub blender_version: Option<BlenderVersion>,
 
-    /// Texels per side (per slice for coat and anisotropic), 1 to 8192 (coat 1024, anisotropic 32) [default: 512 for split-sum, 16 for anisotropic, 64 otherwise].
+    /// Texels per side (per slice for coat and anisotropic), 1 to 8192 (coat 1024, anisotropic 2 to 32) [default: 512 for split-sum, 16 for anisotropic, 64 otherwise].
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
 

@@ -142,7 +142,8 @@ pub fn lut(s: &LutSummary) -> String {
                 list.join(", ")
             );
             out += &format!(
-                "  row l at ry = (l + ½)/{n}; in a slice, texel (x, y) at rx = (x − {n}k + ½)/{n}, N·V = (y − {n}l + ½)/{n}; αx = rx², αy = ry²; first row first\n"
+                "  row l at ry = l/{m}; in a slice, texel (x, y) at rx = (x − {n}k)/{m}, N·V = (y − {n}l)/{m} (grid points: sample at u = (rx·{m} + ½)/{n}); αx = rx², αy = ry²; first row first\n",
+                m = n - 1
             );
         }
         (None, Some(ior)) => {

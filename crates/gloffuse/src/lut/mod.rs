@@ -34,9 +34,9 @@
 //!   coat with its lost energy given back, **G = E(μ, r)**. Quadrature, no samples.
 //!
 //! * [`Kind::Anisotropic`], 2 channels, Cycles' anisotropic GGX or Beckmann lobe (see
-//!   [`anisotropic`]): an atlas of 8 view azimuths side by side × n bitangent widths
-//!   stacked, each slice n × n over (tangent width, N·V): **R = E(μ, φ, αx, αy)**,
-//!   **G = E_avg(αx, αy)**. Quadrature, no samples.
+//!   [`anisotropic`]): an atlas of 16 view azimuths side by side × n bitangent widths
+//!   stacked, each slice n × n over (tangent width, N·V) at grid points, not pixel centres:
+//!   **R = E(μ, φ, αx, αy)**, **G = E_avg(αx, αy)**. Quadrature, no samples.
 //!
 //! # Formats
 //!
@@ -472,13 +472,13 @@ fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
             ),
         ));
     }
-    if args.kind == Kind::Anisotropic && size > anisotropic::MAX_SIZE {
+    if args.kind == Kind::Anisotropic && !(2..=anisotropic::MAX_SIZE).contains(&size) {
         return Err(Error::input(
             Field::Size,
             size,
             Hint::new(
                 format!(
-                    "texels per slice side from 1 to {} for {{}} anisotropic (its atlas holds {} × size slices of size² albedos, each a 9,216-point quadrature)",
+                    "texels per slice side from 2 to {} for {{}} anisotropic (its atlas holds {} × size slices of size² albedos, each a 9,216-point quadrature)",
                     anisotropic::MAX_SIZE,
                     anisotropic::AZIMUTHS
                 ),
@@ -774,7 +774,7 @@ impl Spec {
             Spec::Coat { .. } => &["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
             Spec::Albedo { .. } => &["R: E(μ, r)", "G: E_avg(r)"],
             Spec::Anisotropic { .. } => &[
-                "R: E(μ, φ of the slice's column, αx = rx², αy = ry² of the slice's row)",
+                "R: E(N·V, φ of the slice's column, αx = rx², αy = ry² of the slice's row)",
                 "G: E_avg(αx, αy)",
             ],
         }
