@@ -104,8 +104,9 @@ fn previews_tell_groups_apart(label: &str, dir: &std::path::Path) {
         .filter_map(|n| n.strip_suffix(".png").map(str::to_string))
         .collect();
     groups.sort();
-    // Three distributions, each with its roughness, view and multiscatter group.
-    assert_eq!(groups.len(), 9, "Blender {label}: {groups:?}");
+    // Three distributions, each with its roughness, view and multiscatter group, and the
+    // anisotropic GGX group.
+    assert_eq!(groups.len(), 10, "Blender {label}: {groups:?}");
     let images: Vec<_> = groups.iter().map(|g| preview(dir, g)).collect();
     let height = images[0].height();
     // Nothing is cut off at the sides: the outer columns stay transparent.
@@ -136,6 +137,14 @@ fn previews_tell_groups_apart(label: &str, dir: &std::path::Path) {
             "Blender {label}: {kind}'s GGX and Beckmann spheres differ in {apart} pixels only"
         );
     }
+    // The anisotropic group's highlight is stretched: not the view group's sphere.
+    let view = preview(dir, "Gloffuse View (GGX)");
+    let anisotropic = preview(dir, "Gloffuse Anisotropic (GGX)");
+    let apart = pixels_apart(&view, &anisotropic, sphere, 0.03);
+    assert!(
+        apart >= HIGHLIGHT_PIXELS,
+        "Blender {label}: the anisotropic and view GGX spheres differ in {apart} pixels only"
+    );
 }
 
 /// At least this many pixels clearly apart: about one short caption word.
@@ -173,7 +182,7 @@ fn generated_blend_works_in_every_blender() {
                 "--mode",
                 "view",
             ])
-            .args(["--mode", "multiscatter", "--blend"])
+            .args(["--mode", "multiscatter", "--mode", "anisotropic", "--blend"])
             .arg(&blend)
             .arg("--script")
             .arg(&script)

@@ -192,6 +192,17 @@ def glossy_node(nodes, distribution):
     return node
 
 
+def anisotropic_glossy_node(nodes, distribution):
+    """Blender's anisotropic glossy BSDF with an explicit distribution: 4.0+'s
+    Glossy BSDF (it has Anisotropy, Rotation and Tangent), 3.x's Anisotropic
+    BSDF (its Glossy has none)."""
+    if bpy.app.version >= (4, 0, 0):
+        return glossy_node(nodes, distribution)
+    node = nodes.new("ShaderNodeBsdfAnisotropic")
+    node.distribution = distribution
+    return node
+
+
 def principled_coat_node(nodes):
     """A Principled BSDF that is its dielectric specular layer alone (Base
     Color black, Metallic 0, Multiscatter GGX), or None before 4.0. From 4.0

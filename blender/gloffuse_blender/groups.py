@@ -9,9 +9,10 @@
 #                                                     params.py's resolve_params)
 #   mark_library(params), library_contents() -> the marker of a gloffuse library
 # ---------------------------------------------------------------------------
-from .layered_groups import build_layered_group
 import bpy
 
+from .anisotropic_groups import build_anisotropic_group
+from .layered_groups import build_layered_group
 from .nodes import GLOFFUSE_TAG, is_tagged
 from .normal_group import build_normal_group
 from .params import validate_params
@@ -25,10 +26,12 @@ def group_names(params):
     for spec in params["groups"]:
         view = spec.get("view") or {}
         layered = spec.get("layered") or {}
-        for name in (spec.get("normal_group") if view or layered else None,
+        anisotropic = spec.get("anisotropic") or {}
+        for name in (spec.get("normal_group") if view or layered or anisotropic else None,
                      spec["correction_group"], spec["shader_group"],
                      view.get("correction_group"), view.get("shader_group"),
-                     view.get("multiscatter_group"), layered.get("shader_group")):
+                     view.get("multiscatter_group"), layered.get("shader_group"),
+                     anisotropic.get("shader_group")):
             if name is not None and name not in names:
                 names.append(name)
     return names
@@ -38,7 +41,8 @@ def build_all(params, on_spec=None):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
-    with spec["layered"] the layered group, after the normal group they use
+    with spec["layered"] the layered group, with spec["anisotropic"] the
+    anisotropic group, after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
     with the first spec that uses it. on_spec(spec), if given, is told before
@@ -65,6 +69,8 @@ def build_all(params, on_spec=None):
                 trees.append(build_multiscatter_group(spec, params))
         if spec.get("layered"):
             trees.append(build_layered_group(spec, params))
+        if spec.get("anisotropic"):
+            trees.append(build_anisotropic_group(spec, params))
         built.append((spec, trees))
     names = group_names(params)
     for _spec, trees in built:

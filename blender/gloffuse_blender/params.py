@@ -100,6 +100,12 @@ def resolve_params(document):
                 "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
                 "coat_gain_image": family.get("coat_gain_image"),
             }
+        if spec.get("anisotropic_group") is not None:
+            group["anisotropic"] = {
+                "shader_group": spec["anisotropic_group"],
+                "image": family.get("anisotropic_image"),
+                "table": family.get("anisotropic_table"),
+            }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
     params["groups"] = resolved
@@ -132,7 +138,8 @@ def validate_params(params):
             raise ValueError("%s.engine is %r; expected one of %s"
                              % (where, spec.get("engine"), ", ".join(ENGINES)))
         view = spec.get("view")
-        if (view is not None or spec.get("layered") is not None) \
+        if (view is not None or spec.get("layered") is not None
+                or spec.get("anisotropic") is not None) \
                 and spec.get("normal_group") not in normals:
             # One normal group serves every spec of an engine.
             _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
@@ -168,6 +175,17 @@ def validate_params(params):
                                  "least 2" % where)
             if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
                 raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
+        anisotropic = spec.get("anisotropic")
+        if anisotropic is not None:
+            if not isinstance(anisotropic, dict):
+                raise ValueError("%s.anisotropic must be an object" % where)
+            _name(anisotropic.get("shader_group"), "%s.anisotropic.shader_group" % where, limit, seen)
+            _name(anisotropic.get("image"), "%s.anisotropic.image" % where, limit)
+            table = anisotropic.get("table")
+            if not isinstance(table, dict) or not all(
+                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "azimuths")):
+                raise ValueError("%s.anisotropic.table needs integer size and azimuths of at "
+                                 "least 2" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))

@@ -37,7 +37,10 @@ PREVIEW_COLORS = {
     "view": (0.8, 0.8, 0.8, 1.0),
     "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
     "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
+    "anisotropic": (0.72, 0.78, 0.9, 1.0),  # brushed steel
 }
+# The anisotropic group's preview stretches its highlight along the default tangent.
+PREVIEW_ANISOTROPY = 0.8
 SUN_TOWARDS = (-0.55, -0.75, 0.65)  # upper left, in front: the highlight sits off centre
 SUN_STRENGTH = 3.0
 SUN_ANGLE_DEGREES = 4.0
@@ -153,6 +156,8 @@ def _render_group(scene, mesh, tree, color, path, made):
     color_input = "Color" if "Color" in group.inputs else "Base Color"  # layered groups
     group.inputs[color_input].default_value = color
     group.inputs["Roughness"].default_value = PREVIEW_ROUGHNESS
+    if "Anisotropy" in group.inputs:
+        group.inputs["Anisotropy"].default_value = PREVIEW_ANISOTROPY
     output = node_tree.nodes.new("ShaderNodeOutputMaterial")
     node_tree.links.new(group.outputs["BSDF"], output.inputs["Surface"])
     mesh.materials[0] = material
@@ -172,10 +177,12 @@ def preview_groups(spec):
     [helper names])]."""
     view = spec.get("view") or {}
     layered = spec.get("layered") or {}
+    anisotropic = spec.get("anisotropic") or {}
     groups = [(spec["shader_group"], "roughness", [spec["correction_group"]]),
               (view.get("shader_group"), "view", [view.get("correction_group")]),
               (view.get("multiscatter_group"), "multiscatter", []),
-              (layered.get("shader_group"), "layered", [])]
+              (layered.get("shader_group"), "layered", []),
+              (anisotropic.get("shader_group"), "anisotropic", [])]
     return [(name, kind, helpers) for name, kind, helpers in groups if name]
 
 
@@ -183,7 +190,7 @@ def render_previews(built, directory, on_preview=None):
     """Render a preview for every group of `built` (groups.py's build_all) that
     preview_groups names, into `directory`, and set it as the custom preview of
     that group and of the groups without one that belong to it (the normal
-    group gets the first view, multiscatter or layered group's).
+    group gets the first view, multiscatter, layered or anisotropic group's).
     on_preview(tree name), if given, is told before each render. Headless
     only."""
     images_before = {image.name for image in bpy.data.images}
@@ -191,7 +198,7 @@ def render_previews(built, directory, on_preview=None):
     made = []
     scene, mesh, caption = _preview_scene(made)
     try:
-        shown = {}
+        shown, normals, first_user = {}, {}, {}
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
             for shader_name, kind, helpers in preview_groups(spec):
@@ -208,13 +215,21 @@ def render_previews(built, directory, on_preview=None):
                 for helper in helpers:
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
+            normal_name = spec.get("normal_group")
+            if normal_name in by_name:
+                normals[normal_name] = by_name[normal_name]
             view = spec.get("view") or {}
             layered = spec.get("layered") or {}
-            normal = by_name.get(spec.get("normal_group"))
             first_view = (view.get("shader_group") or view.get("multiscatter_group")
-                          or layered.get("shader_group"))
-            if normal is not None and first_view in shown:
-                _set_preview(normal, shown[first_view])
+                          or layered.get("shader_group")
+                          or (spec.get("anisotropic") or {}).get("shader_group"))
+            if normal_name is not None and first_view in shown:
+                first_user.setdefault(normal_name, shown[first_view])
+        # A normal group is built with the first spec that uses it, but that spec may
+        # have no per-pixel group of its own (an anisotropic library: only GGX has one).
+        for name, tree in normals.items():
+            if name in first_user:
+                _set_preview(tree, first_user[name])
     finally:
         # One batch: removing a mesh one by one would take its object with it first.
         bpy.data.batch_remove(made)

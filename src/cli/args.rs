@@ -203,7 +203,14 @@ const MODES: &[Choice<Mode>] = &[
         Mode::Layered,
         "a dielectric glossy coat (IOR) over a diffuse base: a white base reflects 100 % at every pixel",
     ),
+    choice(
+        Mode::Anisotropic,
+        "an anisotropic Glossy (GGX; Cycles) with gain 1/E(μ, φ, αx, αy), φ the view's azimuth from the tangent: every pixel 100 %",
+    ),
 ];
+
+/// The modes `verify` judges: all but anisotropic (the last), whose sweep is not built yet.
+const VERIFY_MODES: &[Choice<Mode>] = MODES.split_at(MODES.len() - 1).0;
 
 const ENGINES: &[Choice<Engine>] = &[
     choice(
@@ -705,7 +712,7 @@ pub struct VerifyArgs {
     /// view (gain 1/E(μ, r)), multiscatter (Glossy + diffuse (1 − E)) or layered (the
     /// glossy-over-diffuse groups at each --ior, next to the hand-made Mix Shader and
     /// Principled BSDF), all but the first also judged ring by ring.
-    #[arg(long, value_parser = one_of(MODES, Mode::key), default_value = verify_defaults().mode.key())]
+    #[arg(long, value_parser = one_of(VERIFY_MODES, Mode::key), default_value = verify_defaults().mode.key())]
     pub mode: Mode,
 
     /// The spheres' colour as linear R,G,B, each 0 to 1 (e.g. 0.95,0.64,0.54, a copper).

@@ -5,8 +5,12 @@
 #
 #     anisotropic_sphere.py CASES.json OUT.json
 #
-# CASES.json: {"px": N, "samples": S, "cases": [{"distribution": "GGX",
-# "roughness": r, "anisotropy": a}, ...]}. Each case is a unit sphere (smooth
+# CASES.json: {"px": N, "samples": S, "script": optional gloffuse generate
+# script, run first to build its groups in this Blender, "cases":
+# [{"distribution": "GGX", "roughness": r, "anisotropy": a, "rotation": t,
+# "group": optional name}, ...]}. A case with a "group" is shaded with that
+# node group (white Color, the case's Roughness, Anisotropy and Rotation,
+# Normal and Tangent unconnected); one without, with Blender's own BSDF. Each case is a unit sphere (smooth
 # UV sphere) at the origin, an orthographic camera on -Y looking along +Y with
 # ortho scale 2 (pixel (col, row) sees x = (col + 1/2)/N * 2 - 1, z likewise,
 # bottom row first), a white world of strength 1, and a point-like pixel
@@ -24,7 +28,41 @@ import tempfile
 import bpy
 
 
+def build_groups(script):
+    """Run a gloffuse generate script in this process: its groups are built in
+    the open file."""
+    saved = sys.argv
+    # No options; and the job is not the program (sys.argv[0] is this file, which
+    # runpy would replace), so it returns instead of ending the process.
+    sys.argv = [__file__]
+    try:
+        with open(script, encoding="utf-8") as handle:
+            code = compile(handle.read(), script, "exec")
+        exec(code, {"__name__": "__main__", "__file__": script})
+    finally:
+        sys.argv = saved
+
+
+def group_material(case):
+    name = case["group"]
+    material = bpy.data.materials.new("group")
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    nodes.clear()
+    output = nodes.new("ShaderNodeOutputMaterial")
+    group = nodes.new("ShaderNodeGroup")
+    group.node_tree = bpy.data.node_groups[name]
+    group.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    for key, socket in (("roughness", "Roughness"), ("anisotropy", "Anisotropy"),
+                        ("rotation", "Rotation")):
+        group.inputs[socket].default_value = case.get(key, 0.0)
+    links.new(group.outputs["BSDF"], output.inputs["Surface"])
+    return material
+
+
 def anisotropic_material(case):
+    if case.get("group"):
+        return group_material(case)
     material = bpy.data.materials.new("anisotropic")
     material.use_nodes = True
     nodes, links = material.node_tree.nodes, material.node_tree.links
@@ -33,6 +71,7 @@ def anisotropic_material(case):
     kind = "ShaderNodeBsdfGlossy" if bpy.app.version >= (4, 0, 0) else "ShaderNodeBsdfAnisotropic"
     bsdf = nodes.new(kind)
     bsdf.distribution = case["distribution"]
+    bsdf.inputs["Rotation"].default_value = case.get("rotation", 0.0)
     bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     bsdf.inputs["Roughness"].default_value = case["roughness"]
     bsdf.inputs["Anisotropy"].default_value = case["anisotropy"]
@@ -83,6 +122,8 @@ def main(argv):
         request = json.load(handle)
     px = int(request["px"])
     scene, sphere = build_scene(px, int(request["samples"]))
+    if request.get("script"):
+        build_groups(request["script"])
     renders = []
     with tempfile.TemporaryDirectory() as folder:
         for index, case in enumerate(request["cases"]):

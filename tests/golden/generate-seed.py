@@ -197,6 +197,17 @@ def glossy_node(nodes, distribution):
     return node
 
 
+def anisotropic_glossy_node(nodes, distribution):
+    """Blender's anisotropic glossy BSDF with an explicit distribution: 4.0+'s
+    Glossy BSDF (it has Anisotropy, Rotation and Tangent), 3.x's Anisotropic
+    BSDF (its Glossy has none)."""
+    if bpy.app.version >= (4, 0, 0):
+        return glossy_node(nodes, distribution)
+    node = nodes.new("ShaderNodeBsdfAnisotropic")
+    node.distribution = distribution
+    return node
+
+
 def principled_coat_node(nodes):
     """A Principled BSDF that is its dielectric specular layer alone (Base
     Color black, Metallic 0, Multiscatter GGX), or None before 4.0. From 4.0
@@ -1152,6 +1163,12 @@ def resolve_params(document):
                 "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
                 "coat_gain_image": family.get("coat_gain_image"),
             }
+        if spec.get("anisotropic_group") is not None:
+            group["anisotropic"] = {
+                "shader_group": spec["anisotropic_group"],
+                "image": family.get("anisotropic_image"),
+                "table": family.get("anisotropic_table"),
+            }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
     params["groups"] = resolved
@@ -1184,7 +1201,8 @@ def validate_params(params):
             raise ValueError("%s.engine is %r; expected one of %s"
                              % (where, spec.get("engine"), ", ".join(ENGINES)))
         view = spec.get("view")
-        if (view is not None or spec.get("layered") is not None) \
+        if (view is not None or spec.get("layered") is not None
+                or spec.get("anisotropic") is not None) \
                 and spec.get("normal_group") not in normals:
             # One normal group serves every spec of an engine.
             _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
@@ -1220,6 +1238,17 @@ def validate_params(params):
                                  "least 2" % where)
             if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
                 raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
+        anisotropic = spec.get("anisotropic")
+        if anisotropic is not None:
+            if not isinstance(anisotropic, dict):
+                raise ValueError("%s.anisotropic must be an object" % where)
+            _name(anisotropic.get("shader_group"), "%s.anisotropic.shader_group" % where, limit, seen)
+            _name(anisotropic.get("image"), "%s.anisotropic.image" % where, limit)
+            table = anisotropic.get("table")
+            if not isinstance(table, dict) or not all(
+                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "azimuths")):
+                raise ValueError("%s.anisotropic.table needs integer size and azimuths of at "
+                                 "least 2" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))
@@ -1830,6 +1859,223 @@ def build_multiscatter_group(spec, params):
                asset_fields(params, "shader"))
     return tree
 
+# ======== gloffuse part: anisotropic_groups.py ========
+# ---------------------------------------------------------------------------
+# gloffuse anisotropic_groups.py: the anisotropic group (spec["anisotropic"]):
+# Blender's own anisotropic Glossy (3.x's Anisotropic BSDF, 4.x/5.x's Glossy
+# with Anisotropy) whose colour is multiplied by 1 / E(mu, phi, ax, ay).
+#
+# What the lobe loses depends on where the view lies relative to the tangent,
+# not only on mu. The group rebuilds what Cycles does with its inputs: the
+# widths ax = a(1 - A), ay = a / (1 - A) (A < 0 swaps them; each clamped to 1,
+# a = r^2), the tangent (unconnected: a Tangent node, radial about Z, as Cycles
+# links one itself) turned about the normal by Rotation x 2 pi, the frame
+# Y = normalize(N x T), X = Y x N at the normal the BSDF shades with (the
+# normal group), and the view's azimuth phi from X, folded into [0, pi/2] by
+# the lobe's mirror symmetries. E travels as a 4-D table (N.V, phi, sqrt(ax),
+# sqrt(ay) on grid points) packed like the view groups' E(mu, r): each pixel
+# holds the four corners of an (N.V, sqrt(ax)) cell, one block of cells per
+# (phi, sqrt(ay)) grid point; four unfiltered reads and linear blends give the
+# 4-linear interpolation, the same numbers in every engine.
+#
+# A module of the gloffuse_blender package. Functions and constants only.
+#
+#   build_anisotropic_group(spec, params) -> tree
+# ---------------------------------------------------------------------------
+
+
+
+ANISOTROPY_INPUTS = [
+    {"in_out": "INPUT", "name": "Anisotropy", "type": "NodeSocketFloat", "subtype": "FACTOR",
+     "default": 0.5, "min": -1.0, "max": 1.0,
+     "description": "Stretch of the highlight along the tangent (> 0) or across it (< 0), "
+                    "as the Glossy BSDF's Anisotropy"},
+    {"in_out": "INPUT", "name": "Rotation", "type": "NodeSocketFloat", "subtype": "FACTOR",
+     "default": 0.0, "min": 0.0, "max": 1.0,
+     "description": "Turn of the tangent about the normal, in whole turns"},
+]
+
+TANGENT_INPUT = {
+    "in_out": "INPUT", "name": "Tangent", "type": "NodeSocketVector", "hide_value": True,
+    "description": "Tangent of the anisotropy; unconnected means radial about the object's Z "
+                   "axis, as Blender's own default"}
+
+
+def anisotropic_sockets(spec):
+    """Color, Roughness, Anisotropy, Rotation, Normal, Tangent [, Bump Map
+    Correction] -> BSDF."""
+    color, roughness = (
+        {"in_out": "INPUT", "name": "Color", "type": "NodeSocketColor",
+         "default": (1.0, 1.0, 1.0, 1.0), "description": "Colour of the glossy reflection"},
+        {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
+         "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness (0..1)"})
+    return [color, roughness] + ANISOTROPY_INPUTS + [NORMAL_INPUT, TANGENT_INPUT] \
+        + bump_map_correction_inputs(spec) + [
+            {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
+             "description": "Anisotropic glossy BSDF at 100 % brightness for every view"}]
+
+
+def anisotropic_image(anisotropic):
+    """The packed float image holding E(mu, phi, ax, ay): pixel (l (n - 1) + j,
+    k (n - 1) + i) holds the corners of the cell between mu_i and mu_i+1 and
+    sqrt(ax)_j and sqrt(ax)_j+1, at azimuth phi_k and sqrt(ay)_l (bottom row
+    first); table values[((k n + i) n + l) n + j] = E(mu_i, phi_k, rx_j, ry_l)."""
+    table = anisotropic["table"]
+    n, azimuths = int(table["size"]), int(table["azimuths"])
+    values = finite_list(table["values"], "anisotropic.table.values")
+    if len(values) != azimuths * n ** 3:
+        raise ValueError("anisotropic.table holds %d values, not %d x %d^3"
+                         % (len(values), azimuths, n))
+
+    def at(k, i, l, j):
+        return values[((k * n + i) * n + l) * n + j]
+
+    pixels = []
+    for k in range(azimuths):
+        for i in range(n - 1):
+            for l in range(n):
+                for j in range(n - 1):
+                    pixels.extend((at(k, i, l, j), at(k, i, l, j + 1),
+                                   at(k, i + 1, l, j), at(k, i + 1, l, j + 1)))
+    return packed_float_image(anisotropic["image"], (n - 1) * n, (n - 1) * azimuths, pixels)
+
+
+def _tangent(tree, chain, group_in, normal, frame):
+    """The tangent Cycles' lobe uses: the Tangent input (or, unconnected, a
+    Tangent node radial about Z), turned about the shading normal by
+    Rotation x 2 pi. Returns (tangent before the turn, turned tangent)."""
+    nodes = tree.nodes
+    default = nodes.new("ShaderNodeTangent")
+    default.name = "Default tangent"
+    default.label = "Tangent: radial about Z (Cycles' own default)"
+    default.direction_type = "RADIAL"
+    default.axis = "Z"
+    set_parent(default, frame)
+    default.location = (FRAME_INSET, -3 * ROW_STEP)
+    given = group_in.outputs["Tangent"]
+    connected = chain.math("GREATER_THAN", "Tangent connected",
+                           chain.vector("LENGTH", "|Tangent|", given), 1e-6)
+    tangent = chain.select("T", connected, default.outputs["Tangent"], given)
+    turn = nodes.new("ShaderNodeVectorRotate")
+    turn.name = "Turn the tangent"
+    turn.label = "T turned about N by Rotation x 2 pi"
+    turn.rotation_type = "AXIS_ANGLE"
+    set_parent(turn, frame)
+    turn.location = (FRAME_INSET + COLUMN_STEP * (chain.column + 1), chain.y)
+    chain.skip(1)
+    tree.links.new(tangent, turn.inputs["Vector"])
+    tree.links.new(normal, turn.inputs["Axis"])
+    tree.links.new(chain.math("MULTIPLY", "angle = Rotation x 2 pi",
+                              group_in.outputs["Rotation"], 2.0 * math.pi),
+                   turn.inputs["Angle"])
+    return tangent, turn.outputs["Vector"]
+
+
+def _widths(chain, group_in):
+    """sqrt(ax), sqrt(ay) as Cycles maps Roughness r and Anisotropy A:
+    a = r^2, A clamped to [-0.99, 0.99], s = (1 - |A|)^sign(A),
+    ax = min(a s, 1), ay = min(a / s, 1)."""
+    r = chain.clamp("r = clamp(Roughness)", group_in.outputs["Roughness"], 0.0, 1.0)
+    alpha = chain.math("MULTIPLY", "a = r^2", r, r)
+    a = chain.clamp("A = clamp(Anisotropy, -0.99, 0.99)", group_in.outputs["Anisotropy"], -0.99, 0.99)
+    s = chain.math("POWER", "s = (1 - |A|)^sign(A)",
+                   chain.math("SUBTRACT", "1 - |A|", 1.0, chain.math("ABSOLUTE", "|A|", a)),
+                   chain.math("SIGN", "sign(A)", a))
+    ax = chain.math("MINIMUM", "ax = min(a s, 1)", chain.math("MULTIPLY", "a s", alpha, s), 1.0)
+    ay = chain.math("MINIMUM", "ay = min(a / s, 1)", chain.math("DIVIDE", "a / s", alpha, s), 1.0)
+    return chain.math("SQRT", "sqrt(ax)", ax), chain.math("SQRT", "sqrt(ay)", ay)
+
+
+def _azimuth(chain, normal, tangent, incoming):
+    """phi / (pi/2): the view's azimuth from X in Cycles' frame Y =
+    normalize(N x T), X = Y x N, folded into [0, 1]."""
+    y = chain.vector("NORMALIZE", "Y = normalize(N x T)", chain.vector("CROSS_PRODUCT", "N x T", normal, tangent))
+    x = chain.vector("CROSS_PRODUCT", "X = Y x N", y, normal)
+    vx = chain.math("ABSOLUTE", "|I . X|", chain.vector("DOT_PRODUCT", "I . X", incoming, x))
+    vy = chain.math("ABSOLUTE", "|I . Y|", chain.vector("DOT_PRODUCT", "I . Y", incoming, y))
+    return chain.math("MULTIPLY", "t = phi / (pi/2)", chain.math("ARCTAN2", "phi = atan2(|I.Y|, |I.X|)", vy, vx),
+                      2.0 / math.pi)
+
+
+def _lookup(chain, anisotropic, mu, t, rx, ry):
+    """E(mu, phi, ax, ay): four reads of the packed image and 4-linear
+    interpolation."""
+    table = anisotropic["table"]
+    n, azimuths = float(table["size"]), float(table["azimuths"])
+    image = anisotropic_image(anisotropic)
+    row, up = grid_cell(chain, mu, int(n), "mu")
+    column, across = grid_cell(chain, rx, int(n), "sqrt(ax)")
+    k, along_phi = grid_cell(chain, t, int(azimuths), "phi")
+    l, along_ry = grid_cell(chain, ry, int(n), "sqrt(ay)")
+    values = {}
+    for dk in (0, 1):
+        block_row = chain.math("MULTIPLY_ADD", "row: (k + %d)(n - 1) + i" % dk,
+                               chain.math("ADD", "k + %d" % dk, k, float(dk)), n - 1.0, row)
+        for dl in (0, 1):
+            block_column = chain.math("MULTIPLY_ADD", "column: (l + %d)(n - 1) + j" % dl,
+                                      chain.math("ADD", "l + %d" % dl, l, float(dl)), n - 1.0, column)
+            label = "E at phi_k+%d, sqrt(ay)_l+%d" % (dk, dl)
+            values[dk, dl] = bilinear(chain, read_cell(chain, image, block_column, block_row, label),
+                                      across, up, label)
+    lower = chain.mix_value("E at phi_k", along_ry, values[0, 0], values[0, 1])
+    upper = chain.mix_value("E at phi_k+1", along_ry, values[1, 0], values[1, 1])
+    return chain.mix_value("E(mu, phi, ax, ay)", along_phi, lower, upper)
+
+
+def build_anisotropic_group(spec, params):
+    """Color, Roughness, Anisotropy, Rotation, Normal, Tangent -> BSDF: the
+    anisotropic Glossy of colour Color / E(mu, phi, ax, ay)."""
+    anisotropic = spec["anisotropic"]
+    tree = reuse_or_create_group(anisotropic["shader_group"])
+    ensure_interface(tree, anisotropic_sockets(spec))
+    nodes, links = tree.nodes, tree.links
+    group_in = nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+    frame = new_frame(tree, "Albedo frame", "Gain = 1 / E(mu, phi, ax, ay) at the shaded normal and tangent")
+    shading = normal_group_node(tree, bpy.data.node_groups[spec["normal_group"]], group_in,
+                                (FRAME_INSET, -ROW_STEP), frame)
+    normal, mu = shading.outputs["Normal"], shading.outputs["View Cosine"]
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    geometry.name = "Geometry"
+    set_parent(geometry, frame)
+    geometry.location = (FRAME_INSET, -2 * ROW_STEP)
+    chain = Chain(tree, frame, column=1)
+    tangent, turned = _tangent(tree, chain, group_in, normal, frame)
+    rx, ry = _widths(chain, group_in)
+    t = _azimuth(chain, normal, turned, geometry.outputs["Incoming"])
+    albedo = _lookup(chain, anisotropic, mu, t, rx, ry)
+    gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
+    mix, color_a, color_b, color_out = multiply_color_node(nodes)
+    mix.name = "Apply gain"
+    mix.label = "Color x Gain"
+    mix.width = NODE_WIDTH
+    mix.location = (x, 0.0)
+    links.new(group_in.outputs["Color"], color_a)
+    links.new(gain, color_b)
+    glossy = anisotropic_glossy_node(nodes, spec["distribution"])
+    glossy.name = "Anisotropic Glossy BSDF"
+    glossy.width = NODE_WIDTH
+    glossy.location = (x + COLUMN_STEP, 0.0)
+    links.new(color_out, glossy.inputs["Color"])
+    for name in ("Roughness", "Anisotropy", "Rotation", "Normal"):
+        links.new(group_in.outputs[name], glossy.inputs[name])
+    links.new(tangent, glossy.inputs["Tangent"])
+    group_out = nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    links.new(glossy.outputs[0], group_out.inputs["BSDF"])
+    description = description_text(spec, params, (
+        "Blender's anisotropic %s Glossy BSDF whose colour is multiplied by 1 / E(mu, phi, "
+        "ax, ay): its albedo for the view's cosine and azimuth from the tangent at the "
+        "normal it shades with (see '%s'), read from the packed table '%s', so every pixel "
+        "of an evenly lit white surface is 100 %% whatever the anisotropy, rotation and "
+        "tangent. Cycles only: EEVEE renders an anisotropic Glossy as an isotropic one."
+        % (spec["distribution"], spec["normal_group"], anisotropic["image"])))
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "anisotropic"],
+               asset_fields(params, "shader"))
+    return tree
+
 # ======== gloffuse part: layered_groups.py ========
 # ---------------------------------------------------------------------------
 # gloffuse layered_groups.py: "Gloffuse Layered (...)", a dielectric glossy
@@ -2119,10 +2365,12 @@ def group_names(params):
     for spec in params["groups"]:
         view = spec.get("view") or {}
         layered = spec.get("layered") or {}
-        for name in (spec.get("normal_group") if view or layered else None,
+        anisotropic = spec.get("anisotropic") or {}
+        for name in (spec.get("normal_group") if view or layered or anisotropic else None,
                      spec["correction_group"], spec["shader_group"],
                      view.get("correction_group"), view.get("shader_group"),
-                     view.get("multiscatter_group"), layered.get("shader_group")):
+                     view.get("multiscatter_group"), layered.get("shader_group"),
+                     anisotropic.get("shader_group")):
             if name is not None and name not in names:
                 names.append(name)
     return names
@@ -2132,7 +2380,8 @@ def build_all(params, on_spec=None):
     """Build (or rebuild in place) every group of the resolved parameters
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
-    with spec["layered"] the layered group, after the normal group they use
+    with spec["layered"] the layered group, with spec["anisotropic"] the
+    anisotropic group, after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
     with the first spec that uses it. on_spec(spec), if given, is told before
@@ -2159,6 +2408,8 @@ def build_all(params, on_spec=None):
                 trees.append(build_multiscatter_group(spec, params))
         if spec.get("layered"):
             trees.append(build_layered_group(spec, params))
+        if spec.get("anisotropic"):
+            trees.append(build_anisotropic_group(spec, params))
         built.append((spec, trees))
     names = group_names(params)
     for _spec, trees in built:
@@ -2413,7 +2664,10 @@ PREVIEW_COLORS = {
     "view": (0.8, 0.8, 0.8, 1.0),
     "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
     "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
+    "anisotropic": (0.72, 0.78, 0.9, 1.0),  # brushed steel
 }
+# The anisotropic group's preview stretches its highlight along the default tangent.
+PREVIEW_ANISOTROPY = 0.8
 SUN_TOWARDS = (-0.55, -0.75, 0.65)  # upper left, in front: the highlight sits off centre
 SUN_STRENGTH = 3.0
 SUN_ANGLE_DEGREES = 4.0
@@ -2529,6 +2783,8 @@ def _render_group(scene, mesh, tree, color, path, made):
     color_input = "Color" if "Color" in group.inputs else "Base Color"  # layered groups
     group.inputs[color_input].default_value = color
     group.inputs["Roughness"].default_value = PREVIEW_ROUGHNESS
+    if "Anisotropy" in group.inputs:
+        group.inputs["Anisotropy"].default_value = PREVIEW_ANISOTROPY
     output = node_tree.nodes.new("ShaderNodeOutputMaterial")
     node_tree.links.new(group.outputs["BSDF"], output.inputs["Surface"])
     mesh.materials[0] = material
@@ -2548,10 +2804,12 @@ def preview_groups(spec):
     [helper names])]."""
     view = spec.get("view") or {}
     layered = spec.get("layered") or {}
+    anisotropic = spec.get("anisotropic") or {}
     groups = [(spec["shader_group"], "roughness", [spec["correction_group"]]),
               (view.get("shader_group"), "view", [view.get("correction_group")]),
               (view.get("multiscatter_group"), "multiscatter", []),
-              (layered.get("shader_group"), "layered", [])]
+              (layered.get("shader_group"), "layered", []),
+              (anisotropic.get("shader_group"), "anisotropic", [])]
     return [(name, kind, helpers) for name, kind, helpers in groups if name]
 
 
@@ -2559,7 +2817,7 @@ def render_previews(built, directory, on_preview=None):
     """Render a preview for every group of `built` (groups.py's build_all) that
     preview_groups names, into `directory`, and set it as the custom preview of
     that group and of the groups without one that belong to it (the normal
-    group gets the first view, multiscatter or layered group's).
+    group gets the first view, multiscatter, layered or anisotropic group's).
     on_preview(tree name), if given, is told before each render. Headless
     only."""
     images_before = {image.name for image in bpy.data.images}
@@ -2567,7 +2825,7 @@ def render_previews(built, directory, on_preview=None):
     made = []
     scene, mesh, caption = _preview_scene(made)
     try:
-        shown = {}
+        shown, normals, first_user = {}, {}, {}
         for spec, trees in built:
             by_name = {tree.name: tree for tree in trees}
             for shader_name, kind, helpers in preview_groups(spec):
@@ -2584,13 +2842,21 @@ def render_previews(built, directory, on_preview=None):
                 for helper in helpers:
                     if helper in by_name:
                         _set_preview(by_name[helper], path)
+            normal_name = spec.get("normal_group")
+            if normal_name in by_name:
+                normals[normal_name] = by_name[normal_name]
             view = spec.get("view") or {}
             layered = spec.get("layered") or {}
-            normal = by_name.get(spec.get("normal_group"))
             first_view = (view.get("shader_group") or view.get("multiscatter_group")
-                          or layered.get("shader_group"))
-            if normal is not None and first_view in shown:
-                _set_preview(normal, shown[first_view])
+                          or layered.get("shader_group")
+                          or (spec.get("anisotropic") or {}).get("shader_group"))
+            if normal_name is not None and first_view in shown:
+                first_user.setdefault(normal_name, shown[first_view])
+        # A normal group is built with the first spec that uses it, but that spec may
+        # have no per-pixel group of its own (an anisotropic library: only GGX has one).
+        for name, tree in normals.items():
+            if name in first_user:
+                _set_preview(tree, first_user[name])
     finally:
         # One batch: removing a mesh one by one would take its object with it first.
         bpy.data.batch_remove(made)

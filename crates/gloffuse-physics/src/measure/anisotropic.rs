@@ -355,6 +355,31 @@ pub struct AnisotropicAxes {
     pub ry: Vec<f64>,
 }
 
+impl AnisotropicAxes {
+    /// The axes of a table to interpolate in (the LUT and the Blender groups): `n` grid
+    /// points from 0 to 1 on N·V, `√αx` and `√αy`, and `azimuths` from 0 to π/2. Grid
+    /// points, not pixel centres, so both ends are exact: one width is often clamped to 1,
+    /// where E is steep. N·V = 0 is taken at 1e-3 (a limit), and a width of 0 at √α = 0.01:
+    /// a lobe with `αx αy ≤ 1e-7` is a mirror to Cycles, so at an exact 0 one width would
+    /// switch the needle-thin lobe to a mirror.
+    pub fn table(n: usize, azimuths: usize) -> Self {
+        let points = |count: usize, low: f64| -> Vec<f64> {
+            (0..count)
+                .map(|i| (i as f64 / (count.max(2) - 1) as f64).max(low))
+                .collect()
+        };
+        AnisotropicAxes {
+            mu: points(n, 1e-3),
+            phi: points(azimuths, 0.0)
+                .iter()
+                .map(|t| t * FRAC_PI_2)
+                .collect(),
+            rx: points(n, 0.01),
+            ry: points(n, 0.01),
+        }
+    }
+}
+
 /// `E` on [`AnisotropicAxes`] and `E_avg` per pair of widths, from
 /// [`AnisotropicIntegrator::grid`].
 #[derive(Clone, Debug, PartialEq)]

@@ -31,6 +31,10 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/addon.py"),
     ),
     (
+        "anisotropic_groups",
+        include_str!("../../../../blender/gloffuse_blender/anisotropic_groups.py"),
+    ),
+    (
         "audit_job",
         include_str!("../../../../blender/gloffuse_blender/audit_job.py"),
     ),

@@ -210,6 +210,12 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     let pinned = pinned_coefficients(g)?;
     let engines = engines_of(g, pinned.as_ref().map(|(c, name)| (c, *name)))?;
     let blender = blender_for(g, progress)?;
+    if g.modes.contains(&Mode::Anisotropic) {
+        progress.notice(
+            "computing E(μ, φ, αx, αy) for the anisotropic groups, 65,536 albedos for each \
+             masking family",
+        );
+    }
     let mut params = script_params(g, pinned.as_ref(), &engines)?;
     let catalogs = merge_catalogs(g, &mut params)?;
     let script = assemble(&params, Job::Generate);

@@ -7,8 +7,10 @@ use serde::Serialize;
 use super::catalogs::Catalogs;
 use crate::error::{Error, Field};
 use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
+use crate::measure::anisotropic::AnisotropicAxes;
 use crate::measure::{
-    AlbedoIntegrator, BlenderVersion, Distribution, Engine, Masking, Roughness, coat,
+    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, Distribution, Engine, Masking,
+    Roughness, coat,
 };
 use crate::progress::Quiet;
 
@@ -25,14 +27,18 @@ pub enum Mode {
     /// A dielectric glossy coat over a diffuse base (`Gloffuse Layered (…)`): the coat
     /// reflects A(μ, r, IOR), the base gets the rest.
     Layered,
+    /// An anisotropic Glossy (`Gloffuse Anisotropic (GGX)`) with gain 1/E(μ, φ, αx, αy),
+    /// φ the view's azimuth from the tangent: every pixel of a furnace sphere is 100 %.
+    Anisotropic,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 4] = [
+    pub const ALL: [Mode; 5] = [
         Mode::Roughness,
         Mode::View,
         Mode::Multiscatter,
         Mode::Layered,
+        Mode::Anisotropic,
     ];
 
     pub fn key(self) -> &'static str {
@@ -41,6 +47,7 @@ impl Mode {
             Mode::View => "view",
             Mode::Multiscatter => "multiscatter",
             Mode::Layered => "layered",
+            Mode::Anisotropic => "anisotropic",
         }
     }
 
@@ -135,6 +142,51 @@ impl CoatTable {
     }
 }
 
+/// Grid points per axis of the anisotropic groups' table (N·V, √αx, √αy), and view
+/// azimuths: the layout of `lut --kind anisotropic`, whose lookup misses the integrator by
+/// 0.1 % on average and at most 2.5 % at grazing views
+/// (`cargo run --release --example anisotropic_table_error`).
+pub const ANISOTROPIC_TABLE_SIZE: usize = 16;
+pub const ANISOTROPIC_AZIMUTHS: usize = 16;
+
+/// `E(μ, φ, αx, αy)` of the anisotropic groups on [`AnisotropicAxes::table`]: `size` grid
+/// points on N·V, `√αx` and `√αy` from 0 to 1 and `azimuths` on the view azimuth from the
+/// tangent from 0 to π/2.
+#[derive(Clone, Debug, Serialize)]
+pub struct AnisotropicTable {
+    pub size: usize,
+    pub azimuths: usize,
+    /// `values[((k · size + i) · size + l) · size + j] = E(μ_i, φ_k, rx_j, ry_l)`.
+    pub values: Vec<f32>,
+}
+
+impl AnisotropicTable {
+    pub fn compute(distribution: Distribution, masking: Masking) -> Self {
+        let (size, azimuths) = (ANISOTROPIC_TABLE_SIZE, ANISOTROPIC_AZIMUTHS);
+        let grid = AnisotropicIntegrator::default()
+            .grid(
+                distribution,
+                masking,
+                AnisotropicAxes::table(size, azimuths),
+                &Quiet,
+            )
+            .expect("the table's widths are within [0, 1] and its distribution is GGX");
+        let mut values = Vec::with_capacity(azimuths * size * size * size);
+        for k in 0..azimuths {
+            for i in 0..size {
+                for l in 0..size {
+                    values.extend((0..size).map(|j| grid.e(i, k, j, l) as f32));
+                }
+            }
+        }
+        AnisotropicTable {
+            size,
+            azimuths,
+            values,
+        }
+    }
+}
+
 /// E(μ, r) on a grid (row i is μ = i/(height − 1), column j is r = j/(width − 1)) and
 /// E_avg(r) per column.
 #[derive(Clone, Debug, Serialize)]
@@ -199,6 +251,11 @@ pub struct FamilySpec {
     /// Name of the packed float image holding `coat_table.gain` (layered Beckmann only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coat_gain_image: Option<String>,
+    /// Name of the packed float image holding `anisotropic_table` (anisotropic mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub anisotropic_image: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub anisotropic_table: Option<AnisotropicTable>,
 }
 
 /// One distribution's node groups, as the Python side builds them. The script picks the
@@ -223,6 +280,9 @@ pub struct GroupSpec {
     /// `Gloffuse Layered (…)` (layered mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub layered_group: Option<String>,
+    /// `Gloffuse Anisotropic (GGX)` (anisotropic mode, GGX only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub anisotropic_group: Option<String>,
     pub families: Vec<FamilySpec>,
 }
 
@@ -235,6 +295,7 @@ impl GroupSpec {
             Mode::View => view.and_then(|v| v.shader_group.as_deref()),
             Mode::Multiscatter => view.and_then(|v| v.multiscatter_group.as_deref()),
             Mode::Layered => self.layered_group.as_deref(),
+            Mode::Anisotropic => self.anisotropic_group.as_deref(),
         }
     }
 
@@ -246,6 +307,7 @@ impl GroupSpec {
             names.extend(view.into_iter().flatten().cloned());
         }
         names.extend(self.layered_group.iter().cloned());
+        names.extend(self.anisotropic_group.iter().cloned());
         names
     }
 }
@@ -321,6 +383,11 @@ pub fn layered_group_name(d: Distribution) -> String {
     format!("Gloffuse Layered ({})", d.label())
 }
 
+/// `Gloffuse Anisotropic (GGX)`: the public name of the anisotropic glossy group.
+pub fn anisotropic_group_name(d: Distribution) -> String {
+    format!("Gloffuse Anisotropic ({})", d.label())
+}
+
 /// `Gloffuse Multiscatter (GGX)`: the public name of the Glossy + lost-energy group.
 pub fn multiscatter_group_name(engine: Engine, d: Distribution) -> String {
     format!(
@@ -355,6 +422,14 @@ impl GenerateParams {
                 Mode::Layered.key(),
                 "roughness, view or multiscatter for EEVEE: the layered groups are calibrated \
                  for Cycles, and in EEVEE's furnace their rings miss 2 % (docs/EEVEE.md)",
+            ));
+        }
+        if engines.contains(&Engine::Eevee) && modes.contains(&Mode::Anisotropic) {
+            return Err(Error::input(
+                Field::Mode,
+                Mode::Anisotropic.key(),
+                "roughness, view or multiscatter for EEVEE: EEVEE renders an anisotropic \
+                 Glossy as an isotropic one, so the anisotropic groups are built for Cycles only",
             ));
         }
         let mut groups = Vec::new();
@@ -429,17 +504,24 @@ fn group_spec(
     modes: &[Mode],
 ) -> GroupSpec {
     let wants = |m: Mode| modes.contains(&m);
-    // Every per-pixel group reads E(μ, r) and the shading normal.
-    let views = modes.iter().any(|m| m.per_pixel());
+    // Every per-pixel group reads the shading normal; all but the anisotropic one E(μ, r).
+    let normal = modes.iter().any(|m| m.per_pixel());
+    let views = modes
+        .iter()
+        .any(|m| m.per_pixel() && *m != Mode::Anisotropic);
     let layered = wants(Mode::Layered);
+    // Anisotropic Beckmann is not built yet: Blender 3.0–3.4 sample an isotropic lobe for
+    // it (docs/PHYSICS.md §14), so its group would have to exist in some Blenders only.
+    let anisotropic = wants(Mode::Anisotropic) && d == Distribution::Ggx;
     let infix = engine_infix(engine);
     GroupSpec {
         distribution: d,
         engine,
         correction_group: correction_group_name(engine, d),
         shader_group: shader_group_name(engine, d),
-        normal_group: views.then(|| normal_group_name(engine)),
+        normal_group: normal.then(|| normal_group_name(engine)),
         layered_group: layered.then(|| layered_group_name(d)),
+        anisotropic_group: anisotropic.then(|| anisotropic_group_name(d)),
         view: (wants(Mode::View) || wants(Mode::Multiscatter)).then(|| ViewNames {
             correction_group: wants(Mode::View)
                 .then(|| format!("Brightness Correction{infix} View ({})", d.label())),
@@ -469,6 +551,10 @@ fn group_spec(
                     coat_table: layered.then(|| CoatTable::compute(d, *masking, COAT_TABLE_SIZE)),
                     coat_gain_image: (layered && d == Distribution::Beckmann)
                         .then(|| format!("Gloffuse coat gain ({}, {})", d.label(), masking)),
+                    anisotropic_image: anisotropic.then(|| {
+                        format!("Gloffuse E(mu, phi, ax, ay) ({}, {})", d.label(), masking)
+                    }),
+                    anisotropic_table: anisotropic.then(|| AnisotropicTable::compute(d, *masking)),
                 })
             })
             .collect(),
