@@ -19,7 +19,8 @@
 #
 # Variants ("kind"):
 #   glossy      a plain Glossy BSDF of "distribution" (MULTI_GGX included)
-#   group       the shader group "group" (Color, Roughness, Normal inputs)
+#   group       the shader group "group" (Color, Roughness, Normal inputs; any
+#               other input set to a value from "inputs": {name: value})
 #   correction  the correction group "group" feeding a plain Glossy of "distribution"
 #   layered     the layered group "group" (Base Color = "color", Roughness,
 #               "ior", "tint" as Specular Tint, Normal)
@@ -148,6 +149,8 @@ def variant_material(scene, variant):
         node = nodes.new("ShaderNodeGroup")
         node.node_tree = bpy.data.node_groups[variant["group"]]
         node.inputs["Color"].default_value = color
+        for name, value in variant.get("inputs", {}).items():
+            node.inputs[name].default_value = value
         links.new(roughness, node.inputs["Roughness"])
         links.new(normal, node.inputs["Normal"])
         shader = node.outputs["BSDF"]
