@@ -449,7 +449,24 @@ fn cases() -> Vec<Case> {
             .no_blender()
             .says(&["'0' for '--timeout", "1..=86400"])
             .writes_nothing_to(&["@/g.blend"]),
+        case(&[
+            "generate",
+            "--engine",
+            "eevee",
+            "--mode",
+            "anisotropic",
+            "--script",
+            "@/g.py",
+        ])
+        .says(&[
+            "invalid --mode 'anisotropic'",
+            "EEVEE renders an anisotropic Glossy as an isotropic one",
+        ])
+        .writes_nothing_to(&["@/g.py"]),
         // --- verify -------------------------------------------------------------------
+        case(&["verify", "--mode", "anisotropic"])
+            .no_blender()
+            .says(&["'anisotropic'", "roughness, view, multiscatter, layered"]),
         case(&["verify", "-r", ""])
             .no_blender()
             .says(&["invalid roughness ''", "a number from 0 to 1"]),
