@@ -1,7 +1,8 @@
 # ---------------------------------------------------------------------------
-# gloffuse anisotropic_groups.py: the anisotropic group (spec["anisotropic"]):
-# Blender's own anisotropic Glossy (3.x's Anisotropic BSDF, 4.x/5.x's Glossy
-# with Anisotropy) whose colour is multiplied by 1 / E(mu, phi, ax, ay).
+# gloffuse anisotropic_groups.py: the anisotropic group (spec["anisotropic"]:
+# GGX, or Beckmann from 3.5): Blender's own anisotropic Glossy (3.x's
+# Anisotropic BSDF, 4.x/5.x's Glossy with Anisotropy) whose colour is
+# multiplied by 1 / E(mu, phi, ax, ay).
 #
 # What the lobe loses depends on where the view lies relative to the tangent,
 # not only on mu. The group rebuilds what Cycles does with its inputs: the

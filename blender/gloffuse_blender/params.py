@@ -100,7 +100,9 @@ def resolve_params(document):
                 "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
                 "coat_gain_image": family.get("coat_gain_image"),
             }
-        if spec.get("anisotropic_group") is not None:
+        # The anisotropic group is built where this Blender's family carries its table
+        # (not Beckmann in 3.0-3.4, which sample the wrong lobe for it).
+        if spec.get("anisotropic_group") is not None and family.get("anisotropic_table") is not None:
             group["anisotropic"] = {
                 "shader_group": spec["anisotropic_group"],
                 "image": family.get("anisotropic_image"),

@@ -1163,7 +1163,9 @@ def resolve_params(document):
                 "coat_image": family.get("coat_image"), "coat_table": family.get("coat_table"),
                 "coat_gain_image": family.get("coat_gain_image"),
             }
-        if spec.get("anisotropic_group") is not None:
+        # The anisotropic group is built where this Blender's family carries its table
+        # (not Beckmann in 3.0-3.4, which sample the wrong lobe for it).
+        if spec.get("anisotropic_group") is not None and family.get("anisotropic_table") is not None:
             group["anisotropic"] = {
                 "shader_group": spec["anisotropic_group"],
                 "image": family.get("anisotropic_image"),
@@ -1861,9 +1863,10 @@ def build_multiscatter_group(spec, params):
 
 # ======== gloffuse part: anisotropic_groups.py ========
 # ---------------------------------------------------------------------------
-# gloffuse anisotropic_groups.py: the anisotropic group (spec["anisotropic"]):
-# Blender's own anisotropic Glossy (3.x's Anisotropic BSDF, 4.x/5.x's Glossy
-# with Anisotropy) whose colour is multiplied by 1 / E(mu, phi, ax, ay).
+# gloffuse anisotropic_groups.py: the anisotropic group (spec["anisotropic"]:
+# GGX, or Beckmann from 3.5): Blender's own anisotropic Glossy (3.x's
+# Anisotropic BSDF, 4.x/5.x's Glossy with Anisotropy) whose colour is
+# multiplied by 1 / E(mu, phi, ax, ay).
 #
 # What the lobe loses depends on where the view lies relative to the tangent,
 # not only on mu. The group rebuilds what Cycles does with its inputs: the

@@ -84,6 +84,8 @@ pub struct Generated {
     /// The catalog definition file written (merged) beside a new .blend.
     pub catalogs: Option<PathBuf>,
     pub extension: Option<PathBuf>,
+    /// The groups built, as the job reports them when a Blender ran; else every group the
+    /// script builds (in Blender 3.0–3.4 it leaves out anisotropic Beckmann).
     pub groups: Vec<String>,
     /// The user's own groups (no gloffuse tag) that had a name gloffuse builds: renamed out
     /// of the way, every material using them still does.
@@ -244,6 +246,9 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     let built = run_blender(g, &blender, &script, user_blend.as_ref(), progress)?;
     out.log = Some(built.log.clone());
     out.renamed = built.renamed.clone();
+    if let Some(groups) = &built.groups {
+        out.groups = groups.clone();
+    }
     // Everything is made before anything is written: a failed run leaves no output at all,
     // and the catalog file is staged (under its lock) before the library is replaced.
     let package = package_extension(g, &built, &params, &blender)?;
@@ -396,6 +401,9 @@ struct Built {
     target: Destination,
     log: PathBuf,
     renamed: Vec<RenamedGroup>,
+    /// The groups the job built, as it says (a script builds some groups only in some
+    /// Blenders: anisotropic Beckmann from 3.5).
+    groups: Option<Vec<String>>,
 }
 
 /// Runs the script in `blender`, saving the .blend under a temporary name, and checks that
@@ -449,6 +457,12 @@ fn run_blender(
     // A run stopped while Blender saved leaves its partial `NAME@` beside the temp name.
     let output = run_following(&run, progress).inspect_err(|_| remove_partial_save(&tmp))?;
     let renamed = job_report(g, &output.result)?;
+    let groups = output.result["groups"].as_array().map(|names| {
+        names
+            .iter()
+            .filter_map(|n| n.as_str().map(str::to_string))
+            .collect()
+    });
     if let Some(why) = incomplete_blend(&tmp) {
         return Err(Error::Blender {
             message: format!("Blender reported success but {why}").into(),
@@ -462,6 +476,7 @@ fn run_blender(
         target,
         log,
         renamed,
+        groups,
     })
 }
 

@@ -170,7 +170,7 @@ impl AnisotropicTable {
                 AnisotropicAxes::table(size, azimuths),
                 &Quiet,
             )
-            .expect("the table's widths are within [0, 1] and its distribution is GGX");
+            .expect("the table's widths are within [0, 1] and its distribution GGX or Beckmann");
         let mut values = Vec::with_capacity(azimuths * size * size * size);
         for k in 0..azimuths {
             for i in 0..size {
@@ -251,7 +251,8 @@ pub struct FamilySpec {
     /// Name of the packed float image holding `coat_table.gain` (layered Beckmann only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coat_gain_image: Option<String>,
-    /// Name of the packed float image holding `anisotropic_table` (anisotropic mode only).
+    /// Name of the packed float image holding `anisotropic_table` (anisotropic mode, where
+    /// this family's Blenders render the lobe).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub anisotropic_image: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -280,7 +281,8 @@ pub struct GroupSpec {
     /// `Gloffuse Layered (…)` (layered mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub layered_group: Option<String>,
-    /// `Gloffuse Anisotropic (GGX)` (anisotropic mode, GGX only).
+    /// `Gloffuse Anisotropic (GGX | Beckmann)` (anisotropic mode; a script builds it only
+    /// in the Blenders whose family carries its table: not Beckmann in 3.0–3.4).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub anisotropic_group: Option<String>,
     pub families: Vec<FamilySpec>,
@@ -510,9 +512,8 @@ fn group_spec(
         .iter()
         .any(|m| m.per_pixel() && *m != Mode::Anisotropic);
     let layered = wants(Mode::Layered);
-    // Anisotropic Beckmann is not built yet: Blender 3.0–3.4 sample an isotropic lobe for
-    // it (docs/PHYSICS.md §14), so its group would have to exist in some Blenders only.
-    let anisotropic = wants(Mode::Anisotropic) && d == Distribution::Ggx;
+    // Anisotropic GGX and Beckmann (Ashikhmin–Shirley's anisotropic lobe is another model).
+    let anisotropic = wants(Mode::Anisotropic) && d != Distribution::AshikhminShirley;
     let infix = engine_infix(engine);
     GroupSpec {
         distribution: d,
@@ -551,14 +552,27 @@ fn group_spec(
                     coat_table: layered.then(|| CoatTable::compute(d, *masking, COAT_TABLE_SIZE)),
                     coat_gain_image: (layered && d == Distribution::Beckmann)
                         .then(|| format!("Gloffuse coat gain ({}, {})", d.label(), masking)),
-                    anisotropic_image: anisotropic.then(|| {
-                        format!("Gloffuse E(mu, phi, ax, ay) ({}, {})", d.label(), masking)
-                    }),
-                    anisotropic_table: anisotropic.then(|| AnisotropicTable::compute(d, *masking)),
+                    anisotropic_image: (anisotropic && family_renders_anisotropic(*masking, d))
+                        .then(|| {
+                            format!("Gloffuse E(mu, phi, ax, ay) ({}, {})", d.label(), masking)
+                        }),
+                    anisotropic_table: (anisotropic && family_renders_anisotropic(*masking, d))
+                        .then(|| AnisotropicTable::compute(d, *masking)),
                 })
             })
             .collect(),
     }
+}
+
+/// Whether the Blenders of a masking family render the anisotropic lobe of `d` (not
+/// Beckmann in 3.0–3.4, the separable family): where they do not, the family carries no
+/// table and the script builds no anisotropic group for `d`.
+fn family_renders_anisotropic(masking: Masking, d: Distribution) -> bool {
+    let first = match masking {
+        Masking::Separable => BlenderVersion::OLDEST,
+        Masking::HeightCorrelated => BlenderVersion::HEIGHT_CORRELATED_FROM,
+    };
+    first.renders_anisotropic(d)
 }
 
 /// The description of a distribution's groups: what the curve restores, where it comes
