@@ -357,14 +357,29 @@ fn an_anisotropic_library_passes_the_asset_checks() {
     };
     let dir = tempfile::tempdir().unwrap();
     let blend = dir.path().join("anisotropic.blend");
-    common::gloffuse()
-        .args(["generate", "--mode", "anisotropic", "--blend"])
+    let out = common::gloffuse()
+        .args(["generate", "--json", "--mode", "anisotropic", "--blend"])
         .arg(&blend)
         .arg("--blender")
         .arg(&blender)
         .args(["--no-provision", "--timeout", "300"])
         .assert()
-        .success();
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    // The summary lists what 3.4 built: no anisotropic Beckmann group.
+    let summary: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let groups: Vec<&str> = summary["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|g| g.as_str())
+        .collect();
+    assert!(
+        groups.contains(&GROUP) && !groups.contains(&BECKMANN_GROUP),
+        "{groups:?}"
+    );
     let checker = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/check_assets.py");
     let result = dir.path().join("assets.json");
     let run = run_in_blender(
