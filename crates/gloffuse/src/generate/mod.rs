@@ -214,8 +214,8 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     let blender = blender_for(g, progress)?;
     if g.modes.contains(&Mode::Anisotropic) {
         progress.notice(
-            "computing E(μ, φ, αx, αy) for the anisotropic groups, 65,536 albedos for each \
-             masking family",
+            "computing E(μ, φ, αx, αy) for the anisotropic groups, 65,536 albedos per distribution \
+             and masking family",
         );
     }
     let mut params = script_params(g, pinned.as_ref(), &engines)?;
