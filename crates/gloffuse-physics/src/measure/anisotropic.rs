@@ -137,11 +137,7 @@ impl AnisotropicLobe {
 
     /// `G2(ωo, ωi)` in the version's masking form.
     fn g2(&self, wo: DVec3, wi: DVec3) -> f64 {
-        let (lo, li) = (self.lambda(wo), self.lambda(wi));
-        match self.masking {
-            Masking::Separable => 1.0 / ((1.0 + lo) * (1.0 + li)),
-            Masking::HeightCorrelated => 1.0 / (1.0 + lo + li),
-        }
+        self.masking.g2(self.lambda(wo), self.lambda(wi))
     }
 
     /// `f(ωo, ωi) cosθi = D G2 / (4 cosθo)` for reflection: the albedo's integrand.
@@ -240,11 +236,7 @@ impl AnisotropicIntegrator {
                 if wi.z <= 0.0 || o_dot_h <= 0.0 {
                     return 0.0;
                 }
-                let li = lobe.lambda(wi);
-                let g2 = match lobe.masking {
-                    Masking::Separable => 1.0 / ((1.0 + lambda_o) * (1.0 + li)),
-                    Masking::HeightCorrelated => 1.0 / (1.0 + lambda_o + li),
-                };
+                let g2 = lobe.masking.g2(lambda_o, lobe.lambda(wi));
                 g2 * o_dot_h / (mu * h.z)
             };
             // Up to the unit lobe's width, in v = √mass (ρ ∝ v near the peak, so no

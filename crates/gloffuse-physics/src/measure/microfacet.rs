@@ -128,6 +128,16 @@ impl Masking {
     }
 }
 
+impl Masking {
+    /// `G2` from the two directions' Smith Λ: `1/((1 + Λo)(1 + Λi))` or `1/(1 + Λo + Λi)`.
+    pub fn g2(self, lambda_o: f64, lambda_i: f64) -> f64 {
+        match self {
+            Masking::Separable => 1.0 / ((1.0 + lambda_o) * (1.0 + lambda_i)),
+            Masking::HeightCorrelated => 1.0 / (1.0 + lambda_o + lambda_i),
+        }
+    }
+}
+
 impl std::fmt::Display for Masking {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.key())
@@ -286,11 +296,7 @@ impl Microfacet {
 
     /// Masking–shadowing `G2(ωo, ωi)` from the cosines of the two directions.
     pub fn g2(self, masking: Masking, cos_o: f64, cos_i: f64) -> f64 {
-        let (lo, li) = (self.lambda(cos_o), self.lambda(cos_i));
-        match masking {
-            Masking::Separable => 1.0 / ((1.0 + lo) * (1.0 + li)),
-            Masking::HeightCorrelated => 1.0 / (1.0 + lo + li),
-        }
+        masking.g2(self.lambda(cos_o), self.lambda(cos_i))
     }
 
     /// The density with which Cycles samples the half vector, per unit solid angle:

@@ -537,6 +537,7 @@ fn group_spec(
                 let e = c.distributions.get(&d)?;
                 // EEVEE renders every distribution as its GGX: the tables are that BSDF's.
                 let (model, model_masking) = engine.model(d, *masking);
+                let rendered_anisotropic = anisotropic && family_renders_anisotropic(*masking, d);
                 Some(FamilySpec {
                     masking: *masking,
                     coefficients_source: format!("{name} ({})", c.name),
@@ -552,11 +553,10 @@ fn group_spec(
                     coat_table: layered.then(|| CoatTable::compute(d, *masking, COAT_TABLE_SIZE)),
                     coat_gain_image: (layered && d == Distribution::Beckmann)
                         .then(|| format!("Gloffuse coat gain ({}, {})", d.label(), masking)),
-                    anisotropic_image: (anisotropic && family_renders_anisotropic(*masking, d))
-                        .then(|| {
-                            format!("Gloffuse E(mu, phi, ax, ay) ({}, {})", d.label(), masking)
-                        }),
-                    anisotropic_table: (anisotropic && family_renders_anisotropic(*masking, d))
+                    anisotropic_image: rendered_anisotropic.then(|| {
+                        format!("Gloffuse E(mu, phi, ax, ay) ({}, {})", d.label(), masking)
+                    }),
+                    anisotropic_table: rendered_anisotropic
                         .then(|| AnisotropicTable::compute(d, *masking)),
                 })
             })
