@@ -4,7 +4,7 @@
 //! of GGX at α = 1.
 
 use glam::DVec3;
-use gloffuse::measure::anisotropic::view;
+use gloffuse::measure::anisotropic::{local_direction, view};
 use gloffuse::measure::{
     AlbedoIntegrator, AnisotropicIntegrator, AnisotropicLobe, Distribution, Glossy, Masking,
     Roughness,
@@ -172,4 +172,50 @@ pub fn brute_force_anisotropic(lobe: &AnisotropicLobe, wo: DVec3, nx: usize, nph
         sum += ring * st * dtheta;
     }
     sum * (2.0 * PI / nphi as f64) / nx as f64
+}
+
+/// The sphere mean under a constant world-X tangent (verify's anisotropic spheres) against
+/// a pixel grid over the disk, each pixel's frame built from its own normal: another route
+/// through the geometry (Cartesian pixels, no symmetry folding). It must also differ from
+/// the turning-tangent average where the lobe is stretched, or the geometry would not matter.
+#[test]
+fn constant_tangent_sphere_mean_matches_a_pixel_grid() {
+    let q = AnisotropicIntegrator::default();
+    for (alpha_x, alpha_y) in [(0.05, 0.8), (0.6, 0.2), (0.3, 0.3)] {
+        let l = lobe(
+            Distribution::Ggx,
+            Masking::HeightCorrelated,
+            alpha_x,
+            alpha_y,
+        );
+        const N: usize = 120;
+        let (sum, count) = (0..N * N)
+            .into_par_iter()
+            .filter_map(|p| {
+                let x = ((p % N) as f64 + 0.5) / N as f64 * 2.0 - 1.0;
+                let y = ((p / N) as f64 + 0.5) / N as f64 * 2.0 - 1.0;
+                let rr = x * x + y * y;
+                (rr < 1.0).then(|| {
+                    let normal = DVec3::new(x, y, (1.0 - rr).sqrt());
+                    q.directional_albedo(&l, local_direction(normal, DVec3::X, DVec3::Z))
+                })
+            })
+            .fold(|| (0.0, 0usize), |(s, n), e| (s + e, n + 1))
+            .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        let grid = sum / count as f64;
+        let mean = q.constant_tangent_sphere_mean(&l);
+        assert!(
+            (mean - grid).abs() < 1e-3,
+            "αx {alpha_x} αy {alpha_y}: quadrature {mean}, pixel grid {grid}"
+        );
+        let turning = q.average_albedo(&l);
+        if alpha_x == alpha_y {
+            assert!(
+                (mean - turning).abs() < 2e-4,
+                "isotropic: {mean} vs {turning}"
+            );
+        } else {
+            assert!((mean - turning).abs() > 5e-3, "{mean} vs {turning}");
+        }
+    }
 }

@@ -464,9 +464,43 @@ fn cases() -> Vec<Case> {
         ])
         .writes_nothing_to(&["@/g.py"]),
         // --- verify -------------------------------------------------------------------
-        case(&["verify", "--mode", "anisotropic"])
+        case(&["verify", "--anisotropy", "0.5"])
             .no_blender()
-            .says(&["'anisotropic'", "roughness, view, multiscatter, layered"]),
+            .says(&[
+                "invalid --anisotropy '0.5'",
+                "--anisotropy goes with --mode anisotropic",
+            ]),
+        case(&["verify", "--mode", "anisotropic", "--anisotropy", "0.5,1.2"])
+            .no_blender()
+            .says(&["invalid --anisotropy '1.2'", "from -0.99 to 0.99"]),
+        case(&[
+            "verify",
+            "--mode",
+            "anisotropic",
+            "--anisotropy",
+            "-0.5,-0.5",
+        ])
+        .no_blender()
+        .says(&["invalid --anisotropy '-0.5'", "each anisotropy once"]),
+        case(&["verify", "--mode", "anisotropic", "--engine", "eevee"])
+            .no_blender()
+            .says(&[
+                "invalid --engine 'eevee'",
+                "cycles with --mode anisotropic",
+                "EEVEE renders an anisotropic Glossy as an isotropic one",
+            ]),
+        case(&[
+            "verify",
+            "--mode",
+            "anisotropic",
+            "--color-model",
+            "physical",
+        ])
+        .no_blender()
+        .says(&[
+            "invalid --color-model 'physical'",
+            "exact with --mode anisotropic",
+        ]),
         case(&["verify", "-r", ""])
             .no_blender()
             .says(&["invalid roughness ''", "a number from 0 to 1"]),

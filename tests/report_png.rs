@@ -112,7 +112,7 @@ fn white_row(
         id,
         distribution,
         roughness: Roughness::new(roughness).unwrap(),
-        ior: None,
+        block: None,
         cycles_uncorrected: None,
         target: [1.0; 3],
         uncorrected_brightness: uncorrected.mean,
@@ -131,7 +131,7 @@ fn white_row(
 fn reference_sphere(roughness: f64, stats: SphereStats) -> ReferenceSphere {
     ReferenceSphere {
         roughness: Roughness::new(roughness).unwrap(),
-        ior: None,
+        block: None,
         cell: 0,
         brightness: stats.mean,
         stats,

@@ -22,6 +22,7 @@ import time
 import bpy
 
 from .compat import (
+    anisotropic_glossy_node,
     compat_camera_rays_only,
     compat_disable_denoising,
     compat_disable_post_processing,
@@ -90,7 +91,9 @@ def furnace_sphere_spec(index, sphere):
     Glossy BSDF), "group" (a gloffuse shader group, with an "ior" for the
     layered groups), "mix" (what artists build by hand: Mix Shader with a
     Fresnel factor over Diffuse and Glossy), "principled" (Principled BSDF) and
-    "diffuse" (a Diffuse BSDF: how bright the engine's lighting itself is)."""
+    "diffuse" (a Diffuse BSDF: how bright the engine's lighting itself is).
+    A "plain" or "group" sphere with an "anisotropy" is anisotropic, its
+    tangent the constant world X."""
     where = "spheres[%d]" % index
     furnace_require(isinstance(sphere, dict), "%s must be an object" % where)
     roughness = furnace_number(sphere, "roughness", float, 0.0, 1.0)
@@ -99,6 +102,8 @@ def furnace_sphere_spec(index, sphere):
     if shader in ("mix", "principled") or (shader == "group" and "ior" in sphere):
         # gloffuse checks the upper bound (the layered table's last slice).
         spec["ior"] = furnace_number(sphere, "ior", float, 1.0)
+    if shader in ("plain", "group") and "anisotropy" in sphere:
+        spec["anisotropy"] = furnace_number(sphere, "anisotropy", float, -0.99, 0.99)
     if shader in ("plain", "mix"):
         distribution = sphere.get("distribution")
         furnace_require(distribution in FURNACE_PLAIN_DISTRIBUTIONS,
@@ -208,7 +213,20 @@ def furnace_label(sphere):
         label = "%s %s" % (sphere["shader"], sphere["distribution"])
     if "ior" in sphere:
         label += " IOR %g" % sphere["ior"]
+    if "anisotropy" in sphere:
+        label += " anisotropy %g" % sphere["anisotropy"]
     return label
+
+
+def furnace_anisotropy(tree, node, anisotropy):
+    """Anisotropy along the constant world X: every pixel of the sphere sees
+    the view at another azimuth from it (Cycles' own default, radial about Z,
+    is square to a camera looking down -Z everywhere)."""
+    tangent = tree.nodes.new("ShaderNodeCombineXYZ")
+    tangent.label = "Tangent: world X"
+    tangent.inputs["X"].default_value = 1.0
+    tree.links.new(tangent.outputs["Vector"], node.inputs["Tangent"])
+    node.inputs["Anisotropy"].default_value = anisotropy
 
 
 def furnace_mix_shader(tree, sphere, color):
@@ -249,6 +267,9 @@ def furnace_material(index, sphere, color):
     elif sphere["shader"] == "diffuse":
         node = tree.nodes.new("ShaderNodeBsdfDiffuse")
         shader_output = node.outputs["BSDF"]
+    elif sphere["shader"] == "plain" and "anisotropy" in sphere:
+        node = anisotropic_glossy_node(tree.nodes, sphere["distribution"])
+        shader_output = node.outputs["BSDF"]
     elif sphere["shader"] == "plain":
         node = tree.nodes.new("ShaderNodeBsdfGlossy")
         node.distribution = sphere["distribution"]
@@ -265,6 +286,8 @@ def furnace_material(index, sphere, color):
         shader_output = furnace_group_output(node)
         if "ior" in sphere:
             node.inputs["IOR"].default_value = sphere["ior"]
+    if "anisotropy" in sphere:
+        furnace_anisotropy(tree, node, sphere["anisotropy"])
     color_input = "Color" if "Color" in node.inputs else "Base Color"
     node.inputs[color_input].default_value = tuple(color) + (1.0,)
     node.inputs["Roughness"].default_value = sphere["roughness"]

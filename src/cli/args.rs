@@ -21,7 +21,9 @@ use gloffuse::measure::{BlenderVersion, Distribution, Engine, Roughness};
 use gloffuse::refresh::RefreshOptions;
 use gloffuse::shard::Shard;
 use gloffuse::verify::plan::default_samples;
-use gloffuse::verify::{Judging, LAYERED_IOR, RenderSettings, VerifyOptions, layered_roughness};
+use gloffuse::verify::{
+    ANISOTROPIC_SWEEP, Judging, LAYERED_IOR, RenderSettings, VerifyOptions, block_roughness,
+};
 
 const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
 const LONG_ABOUT: &str = "\
@@ -208,9 +210,6 @@ const MODES: &[Choice<Mode>] = &[
         "an anisotropic Glossy (GGX; Cycles) with gain 1/E(μ, φ, αx, αy), φ the view's azimuth from the tangent: every pixel 100 %",
     ),
 ];
-
-/// The modes `verify` judges: all but anisotropic (the last), whose sweep is not built yet.
-const VERIFY_MODES: &[Choice<Mode>] = MODES.split_at(MODES.len() - 1).0;
 
 const ENGINES: &[Choice<Engine>] = &[
     choice(
@@ -682,7 +681,7 @@ pub struct VerifyArgs {
     pub distribution: Vec<Distribution>,
 
     /// Roughness values of the sweep, comma-separated, each from 0 to 1 and given once
-    /// [default: 0, 0.1, …, 1; layered mode: 0.1, 0.25, 0.5, 0.75, 1].
+    /// [default: 0, 0.1, …, 1; layered and anisotropic mode: 0.1, 0.25, 0.5, 0.75, 1].
     #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness, allow_hyphen_values = true)]
     pub roughness: Vec<Roughness>,
 
@@ -690,6 +689,16 @@ pub struct VerifyArgs {
     /// and given once [default: 1.33,1.5,2].
     #[arg(long, value_name = "N,...", value_delimiter = ',', value_parser = parse_ior)]
     pub ior: Vec<f64>,
+
+    /// Anisotropic mode: the lobes' anisotropies, comma-separated, each from -0.99 to 0.99
+    /// and given once [default: 0.5,0.9,-0.9]; each sphere's tangent is the world X.
+    #[arg(
+        long,
+        value_name = "A,...",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub anisotropy: Vec<f64>,
 
     /// Samples per pixel [default: Cycles 32, which keeps each sphere's standard error
     /// ≤ 0.2 %; EEVEE 1, its furnace has no noise].
@@ -709,10 +718,12 @@ pub struct VerifyArgs {
     pub seed: u32,
 
     /// Which correction to check: roughness (gain 100/f(r), judged by each sphere's mean),
-    /// view (gain 1/E(μ, r)), multiscatter (Glossy + diffuse (1 − E)) or layered (the
+    /// view (gain 1/E(μ, r)), multiscatter (Glossy + diffuse (1 − E)), layered (the
     /// glossy-over-diffuse groups at each --ior, next to the hand-made Mix Shader and
-    /// Principled BSDF), all but the first also judged ring by ring.
-    #[arg(long, value_parser = one_of(VERIFY_MODES, Mode::key), default_value = verify_defaults().mode.key())]
+    /// Principled BSDF) or anisotropic (gain 1/E(μ, φ, αx, αy) at each --anisotropy, next to
+    /// Blender's anisotropic Multiscatter GGX; Cycles only), all but the first also judged
+    /// ring by ring.
+    #[arg(long, value_parser = one_of(MODES, Mode::key), default_value = verify_defaults().mode.key())]
     pub mode: Mode,
 
     /// The spheres' colour as linear R,G,B, each 0 to 1 (e.g. 0.95,0.64,0.54, a copper).
@@ -898,12 +909,16 @@ impl VerifyArgs {
             distributions: self.distribution.clone(),
             roughness: match (self.roughness.is_empty(), self.mode) {
                 (false, _) => self.roughness.clone(),
-                (true, Mode::Layered) => layered_roughness(),
+                (true, Mode::Layered | Mode::Anisotropic) => block_roughness(),
                 (true, _) => verify_defaults().roughness,
             },
             ior: match (self.ior.is_empty(), self.mode) {
                 (true, Mode::Layered) => LAYERED_IOR.to_vec(),
                 _ => self.ior.clone(),
+            },
+            anisotropy: match (self.anisotropy.is_empty(), self.mode) {
+                (true, Mode::Anisotropic) => ANISOTROPIC_SWEEP.to_vec(),
+                _ => self.anisotropy.clone(),
             },
             render: RenderSettings {
                 cell: self.resolution,
@@ -1227,6 +1242,8 @@ pub fn flag(field: Field) -> String {
         Field::Blend => "--blend",
         Field::Coefficients => "--coefficients",
         Field::Color => "--color",
+        Field::ColorModel => "--color-model",
+        Field::Anisotropy => "--anisotropy",
         Field::Degree => "--degree",
         Field::Distribution => "--distribution",
         Field::Engine => "--engine",
@@ -1261,7 +1278,6 @@ pub fn flag(field: Field) -> String {
         Field::Timeout => "--timeout",
         Field::ViewCosine => "--mu",
         Field::Arguments
-        | Field::Anisotropy
         | Field::Catalogs
         | Field::ContactSheet
         | Field::ModelParameter(_)

@@ -130,6 +130,8 @@ pub enum Field {
     Catalogs,
     Coefficients,
     Color,
+    /// What a coloured correction keeps (exact or physical).
+    ColorModel,
     /// The geometry of a contact sheet of renders.
     ContactSheet,
     /// The degree of a fitted polynomial.
@@ -213,6 +215,7 @@ impl Field {
             Field::Catalogs => "asset catalog file",
             Field::Coefficients => "coefficients",
             Field::Color => "colour",
+            Field::ColorModel => "colour model",
             Field::ContactSheet => "contact sheet",
             Field::Degree => "degree",
             Field::Distribution => "distribution",

@@ -161,6 +161,14 @@ pub fn view(mu: f64, phi: f64) -> DVec3 {
     DVec3::new(sin * phi.cos(), sin * phi.sin(), mu)
 }
 
+/// The direction `w` (world space) in the shading frame Cycles builds from the normal and
+/// tangent: `Y = normalize(N × T)`, `X = Y × N`; returns `(w·X, w·Y, w·N)`.
+pub fn local_direction(normal: DVec3, tangent: DVec3, w: DVec3) -> DVec3 {
+    let y = normal.cross(tangent).normalize();
+    let x = y.cross(normal);
+    DVec3::new(w.dot(x), w.dot(y), w.dot(normal))
+}
+
 /// Numbers of quadrature nodes for [`AnisotropicIntegrator`]; the default meets 2e-4.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AnisotropicQuadrature {
@@ -282,6 +290,32 @@ impl AnisotropicIntegrator {
             for &(x, wp) in &phis {
                 total +=
                     2.0 * mu * wm * wp * self.directional_albedo(lobe, view(mu, FRAC_PI_2 * x));
+            }
+        }
+        total
+    }
+
+    /// The mean brightness of an evenly lit unit sphere seen by an orthographic camera
+    /// looking down −Z, its tangent the constant world X everywhere (verify's anisotropic
+    /// spheres): `(1/π) ∫∫ E μ dμ dβ` over the disk, β the angle about the view axis. Unlike
+    /// [`Self::average_albedo`], whose tangents turn every way, here the view's azimuth
+    /// from the tangent depends on where on the disk a pixel is. The disk's mirror
+    /// symmetries in x and y (which mirror the azimuth, and the lobe is mirror symmetric)
+    /// leave one quadrant of β.
+    pub fn constant_tangent_sphere_mean(&self, lobe: &AnisotropicLobe) -> f64 {
+        if lobe.is_mirror() {
+            return 1.0;
+        }
+        let mus = gauss_unit(AVERAGE_NODES);
+        let betas = gauss_unit(AVERAGE_NODES);
+        let mut total = 0.0;
+        for &(mu, wm) in &mus {
+            let rho = (1.0 - mu * mu).sqrt();
+            for &(x, wb) in &betas {
+                let beta = FRAC_PI_2 * x;
+                let normal = DVec3::new(rho * beta.cos(), rho * beta.sin(), mu);
+                let wo = local_direction(normal, DVec3::X, DVec3::Z);
+                total += 2.0 * mu * wm * wb * self.directional_albedo(lobe, wo);
             }
         }
         total

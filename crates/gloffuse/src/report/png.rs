@@ -21,7 +21,7 @@ use crate::measure::Distribution;
 use crate::output::write_output;
 use crate::verify::VerifyReport;
 use crate::verify::image::Rgba;
-use crate::verify::plan::{Plan, reference_label};
+use crate::verify::plan::{Block, Plan, reference_label};
 
 /// Linear value of the background the spheres are composited over: 18 % grey, the
 /// photographic middle grey, so a sphere brighter or darker than 100 % stands out either way.
@@ -68,8 +68,8 @@ pub fn sheet_labels(plan: &Plan, mode: Mode) -> (Vec<String>, Vec<String>) {
     let rows = plan
         .cells
         .chunks(columns)
-        .map(|row| match row[0].ior {
-            Some(n) => format!("{}, IOR {n}", row[0].role.label(mode)),
+        .map(|row| match row[0].block {
+            Some(b) => format!("{}, {}", row[0].role.label(mode), b.label()),
             None => row[0].role.label(mode),
         })
         .collect();
@@ -333,7 +333,7 @@ struct PlotData {
 
 impl PlotData {
     fn of(report: &VerifyReport) -> Self {
-        let plotted_ior = plotted_ior(report);
+        let plotted = plotted_block(report);
         let mut distributions: Vec<Distribution> = Vec::new();
         for row in &report.rows {
             if !distributions.contains(&row.distribution) {
@@ -342,13 +342,13 @@ impl PlotData {
         }
         let series: Vec<_> = distributions
             .iter()
-            .map(|&d| (d, series_points(report, d, plotted_ior)))
+            .map(|&d| (d, series_points(report, d, plotted)))
             .collect();
         let reference = percent_points(
             report
                 .reference
                 .iter()
-                .filter(|s| s.ior == plotted_ior)
+                .filter(|s| s.block == plotted)
                 .map(|s| (s.roughness.get(), s.brightness)),
         );
         let tolerance = if report.tolerance_percent.is_finite() {
@@ -367,7 +367,7 @@ impl PlotData {
         let (x, y) = plot_ranges(&series, &reference, tolerance);
         PlotData {
             mode: report.mode,
-            title: plot_title(report, plotted_ior),
+            title: plot_title(report, plotted),
             series,
             reference,
             zoom,
@@ -379,27 +379,28 @@ impl PlotData {
     }
 }
 
-/// Layered sweeps plot one index of refraction (glass, 1.5, when it was rendered): the
-/// table, report.json and the zoomed panel hold every index.
-fn plotted_ior(report: &VerifyReport) -> Option<f64> {
-    report.rows.iter().find_map(|r| r.ior).map(|first| {
-        if report.rows.iter().any(|r| r.ior == Some(1.5)) {
-            1.5
+/// Layered and anisotropic sweeps plot one block (layered: glass, IOR 1.5, when it was
+/// rendered; else the first): the table, report.json and the zoomed panel hold every block.
+fn plotted_block(report: &VerifyReport) -> Option<Block> {
+    report.rows.iter().find_map(|r| r.block).map(|first| {
+        let glass = Block::Ior(1.5);
+        if report.rows.iter().any(|r| r.block == Some(glass)) {
+            glass
         } else {
             first
         }
     })
 }
 
-/// Distribution `d`'s points at index `ior`: uncorrected, its prediction, corrected, its
+/// Distribution `d`'s points in `block`: uncorrected, its prediction, corrected, its
 /// prediction.
-fn series_points(report: &VerifyReport, d: Distribution, ior: Option<f64>) -> [Points; 4] {
+fn series_points(report: &VerifyReport, d: Distribution, block: Option<Block>) -> [Points; 4] {
     let pts = |f: fn(&crate::verify::Row) -> f64| {
         percent_points(
             report
                 .rows
                 .iter()
-                .filter(|r| r.distribution == d && r.ior == ior)
+                .filter(|r| r.distribution == d && r.block == block)
                 .map(|r| (r.roughness.get(), f(r))),
         )
     };
@@ -412,7 +413,7 @@ fn series_points(report: &VerifyReport, d: Distribution, ior: Option<f64>) -> [P
 }
 
 /// The zoomed panel's points of distribution `d`: corrected spheres' distance from what
-/// they promise, in %, at every index of refraction.
+/// they promise, in %, in every block.
 fn zoom_points(report: &VerifyReport, d: Distribution) -> Points {
     let rows = report.rows.iter().filter(|r| r.distribution == d);
     let mut points: Points = rows
@@ -446,10 +447,14 @@ fn plot_ranges(
     ((x_lo - x_pad, x_hi + x_pad), (y_lo, y_hi))
 }
 
-fn plot_title(report: &VerifyReport, plotted_ior: Option<f64>) -> String {
-    match plotted_ior {
-        Some(n) => format!(
+fn plot_title(report: &VerifyReport, plotted: Option<Block>) -> String {
+    match plotted {
+        Some(Block::Ior(n)) => format!(
             "Layered furnace brightness · Blender {} · IOR {n} · {} spp",
+            report.render.blender_version, report.render.samples
+        ),
+        Some(Block::Anisotropy(a)) => format!(
+            "Anisotropic furnace brightness · Blender {} · anisotropy {a} · {} spp",
             report.render.blender_version, report.render.samples
         ),
         None => format!(

@@ -77,7 +77,7 @@ fn predict(
 ) -> Prediction {
     let rings: Vec<_> = corrected.rings.iter().map(|r| r.mu).collect();
     let curve = &sweep.coefficients.distributions[&slot.distribution].curve;
-    predictor.predict(curve, slot.distribution, slot.roughness, slot.ior, &rings)
+    predictor.predict(curve, slot.distribution, slot.roughness, slot.block, &rings)
 }
 
 /// One row's verdict: the corrected sphere's mean against its target within the
@@ -98,7 +98,7 @@ pub fn judge_row(
         id: slot.id,
         distribution: slot.distribution,
         roughness: slot.roughness,
-        ior: slot.ior,
+        block: slot.block,
         uncorrected_brightness: relative(uncorrected.mean_rgb, p.uncorrected_base).0,
         uncorrected,
         corrected,
@@ -116,10 +116,10 @@ pub fn judge_row(
 
 /// A reference sphere: its mean relative to what it promises.
 pub fn reference(r: &PlanReference, stats: SphereStats, predictor: &Predictor) -> ReferenceSphere {
-    let promise = predictor.reference_target(r.roughness, r.ior);
+    let promise = predictor.reference_target(r.roughness, r.block);
     ReferenceSphere {
         roughness: r.roughness,
-        ior: r.ior,
+        block: r.block,
         cell: r.cell,
         brightness: relative(stats.mean_rgb, promise).0,
         stats,
@@ -180,7 +180,7 @@ mod tests {
             id: 7,
             distribution: Distribution::Ggx,
             roughness: Roughness::new(0.5).unwrap(),
-            ior: None,
+            block: None,
             uncorrected: 3,
             corrected: 4,
         }

@@ -14,7 +14,7 @@ pub mod verdict;
 
 pub use judge::judge;
 pub use plan::reference_label;
-pub use plan::{Plan, PlanReference, PlanRow, RenderSettings, Role};
+pub use plan::{Block, Plan, PlanReference, PlanRow, RenderSettings, Role};
 pub use render::{RenderInfo, Rendered, render};
 pub use verdict::{Judging, Note, ReferenceSphere, Row, Sweep, VerifyReport, WorstSphere};
 
@@ -22,7 +22,7 @@ use crate::blender::{Blender, BlenderOptions};
 use crate::error::{Error, Field, Hint};
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{Distribution, Engine, Roughness, coat};
+use crate::measure::{Anisotropy, BlenderVersion, Distribution, Engine, Roughness, coat};
 use crate::progress::Progress;
 
 /// What `verify` renders and how it judges it.
@@ -37,6 +37,9 @@ pub struct VerifyOptions {
     /// Layered mode: the coats' indices of refraction, each once, from 1 to
     /// [`coat::IOR_MAX`] (every other mode: none).
     pub ior: Vec<f64>,
+    /// Anisotropic mode: the lobes' anisotropies, each once, from −0.99 to 0.99 (every
+    /// other mode: none).
+    pub anisotropy: Vec<f64>,
     pub render: RenderSettings,
     pub mode: Mode,
     /// The spheres' colour (linear RGB, each in [0, 1]).
@@ -52,9 +55,9 @@ pub fn default_roughness() -> Vec<Roughness> {
     Roughness::grid(11)
 }
 
-/// The layered sweep's roughness values: 0.1, 0.25, 0.5, 0.75, 1 (a smooth coat is a
-/// mirror, which the table holds exactly).
-pub fn layered_roughness() -> Vec<Roughness> {
+/// The layered and anisotropic sweeps' roughness values: 0.1, 0.25, 0.5, 0.75, 1 (a smooth
+/// lobe is a mirror, which the tables hold exactly).
+pub fn block_roughness() -> Vec<Roughness> {
     [0.1, 0.25, 0.5, 0.75, 1.0]
         .map(|r| Roughness::new(r).expect("in [0, 1]"))
         .to_vec()
@@ -63,6 +66,10 @@ pub fn layered_roughness() -> Vec<Roughness> {
 /// The layered sweep's indices of refraction: water, glass, and a dense flint.
 pub const LAYERED_IOR: [f64; 3] = [1.33, 1.5, 2.0];
 
+/// The anisotropic sweep's anisotropies: a moderate and a strong stretch along the tangent,
+/// and a strong one across it (a negative anisotropy swaps the widths).
+pub const ANISOTROPIC_SWEEP: [f64; 3] = [0.5, 0.9, -0.9];
+
 impl Default for VerifyOptions {
     fn default() -> Self {
         VerifyOptions {
@@ -70,6 +77,7 @@ impl Default for VerifyOptions {
             distributions: Vec::new(),
             roughness: default_roughness(),
             ior: Vec::new(),
+            anisotropy: Vec::new(),
             render: RenderSettings::default(),
             mode: Mode::Roughness,
             color: [1.0; 3],
@@ -89,11 +97,8 @@ pub struct Verification {
 /// Checks the options, finds Blender, then [`verify_with`]. Bad input fails before Blender
 /// is looked for.
 pub fn verify(v: &VerifyOptions, progress: &dyn Progress) -> Result<Verification, Error> {
-    check_mode(v.mode)?;
-    check_roughness(&v.roughness)?;
-    check_ior(v.mode, &v.ior)?;
+    check_options(v)?;
     check_color(v.color)?;
-    check_engine(v.render.engine, v.mode)?;
     if let Some(name) = &v.coefficients {
         distributions_of(v, &Coefficients::load(name)?, name)?;
     }
@@ -107,14 +112,13 @@ pub fn verify_with(
     v: &VerifyOptions,
     progress: &dyn Progress,
 ) -> Result<Verification, Error> {
-    check_mode(v.mode)?;
-    check_roughness(&v.roughness)?;
-    check_ior(v.mode, &v.ior)?;
-    check_engine(v.render.engine, v.mode)?;
+    check_options(v)?;
     let (coefficients, source) =
         Coefficients::load_or_preset(v.coefficients.as_deref(), v.render.engine, blender.version)?;
     let distributions = distributions_of(v, &coefficients, &source)?;
-    let plan = Plan::verify(&distributions, &v.roughness, &v.ior, v.render);
+    let distributions = with_groups(v, distributions, blender.version)?;
+    let blocks = blocks(v);
+    let plan = Plan::verify(&distributions, &v.roughness, &blocks, v.render);
     let curves = Curves::Pinned {
         coefficients: &coefficients,
         name: &source,
@@ -133,7 +137,7 @@ pub fn verify_with(
         source: &source,
         distributions: &distributions,
         roughness: &v.roughness,
-        ior: &v.ior,
+        blocks: &blocks,
         mode: v.mode,
         color: v.color,
         color_model: v.color_model,
@@ -142,33 +146,95 @@ pub fn verify_with(
     Ok(Verification { report, rendered })
 }
 
-/// The modes a verify sweep judges: not yet the anisotropic groups, whose sweep needs a
-/// tangent per sphere and an anisotropy per row.
-fn check_mode(mode: Mode) -> Result<(), Error> {
-    if mode == Mode::Anisotropic {
+/// What can be checked before Blender is found.
+fn check_options(v: &VerifyOptions) -> Result<(), Error> {
+    check_roughness(&v.roughness)?;
+    check_ior(v.mode, &v.ior)?;
+    check_anisotropy(v.mode, &v.anisotropy)?;
+    check_engine(v.render.engine, v.mode)?;
+    check_color_model(v.mode, v.color_model)
+}
+
+/// Each block of rows: the indices (layered mode) or the anisotropies (anisotropic mode).
+fn blocks(v: &VerifyOptions) -> Vec<Block> {
+    let ior = v.ior.iter().map(|&n| Block::Ior(n));
+    ior.chain(v.anisotropy.iter().map(|&a| Block::Anisotropy(a)))
+        .collect()
+}
+
+/// EEVEE renders the roughness and view modes; the layered groups are Cycles' only (in
+/// EEVEE's furnace their rings miss 2 %), and EEVEE ignores anisotropy.
+fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
+    let why = match mode {
+        Mode::Layered => {
+            "the layered groups are calibrated for Cycles; in EEVEE's furnace their rings \
+             miss 2 %, docs/EEVEE.md"
+        }
+        Mode::Anisotropic => {
+            "EEVEE renders an anisotropic Glossy as an isotropic one, docs/EEVEE.md"
+        }
+        _ => return Ok(()),
+    };
+    if engine == Engine::Eevee {
         return Err(Error::input(
-            Field::Mode,
-            mode.key(),
-            "roughness, view, multiscatter or layered (verify does not judge the anisotropic \
-             groups yet; tests/anisotropic_e2e.rs renders them in the furnace)",
+            Field::Engine,
+            engine.key(),
+            Hint::new(
+                format!("cycles with {{}} {} ({why})", mode.key()),
+                [Field::Mode],
+            ),
         ));
     }
     Ok(())
 }
 
-/// EEVEE renders the roughness and view modes; the layered groups are Cycles' only (in
-/// EEVEE's furnace their rings miss 2 %).
-fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
-    if engine == Engine::Eevee && mode == Mode::Layered {
+/// The anisotropic groups keep the colour exact (colour / E); no other promise is judged.
+fn check_color_model(mode: Mode, model: ColorModel) -> Result<(), Error> {
+    if mode == Mode::Anisotropic && model != ColorModel::Exact {
         return Err(Error::input(
-            Field::Engine,
-            engine.key(),
+            Field::ColorModel,
+            model.key(),
             Hint::new(
-                "cycles with {} layered (the layered groups are calibrated for Cycles; in \
-                 EEVEE's furnace their rings miss 2 %, docs/EEVEE.md)",
+                "exact with {} anisotropic (its groups multiply the colour by 1/E)",
                 [Field::Mode],
             ),
         ));
+    }
+    Ok(())
+}
+
+/// Anisotropic mode needs anisotropies, each once and in [−0.99, 0.99] (what Cycles
+/// clamps to); every other mode takes none.
+fn check_anisotropy(mode: Mode, anisotropy: &[f64]) -> Result<(), Error> {
+    if mode != Mode::Anisotropic {
+        return match anisotropy.first() {
+            Some(a) => Err(Error::input(
+                Field::Anisotropy,
+                a,
+                Hint::new(
+                    "no anisotropy: {} goes with {} anisotropic",
+                    [Field::Anisotropy, Field::Mode],
+                ),
+            )),
+            None => Ok(()),
+        };
+    }
+    if anisotropy.is_empty() {
+        return Err(Error::input(
+            Field::Anisotropy,
+            "",
+            Hint::new("at least one anisotropy for {} anisotropic", [Field::Mode]),
+        ));
+    }
+    for (i, &a) in anisotropy.iter().enumerate() {
+        let clamped = Anisotropy::new(a).ok().map(Anisotropy::get);
+        if clamped != Some(a) || anisotropy[..i].contains(&a) {
+            return Err(Error::input(
+                Field::Anisotropy,
+                a,
+                "each anisotropy once, from -0.99 to 0.99 (Cycles clamps beyond)",
+            ));
+        }
     }
     Ok(())
 }
@@ -236,6 +302,40 @@ fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// Anisotropic mode sweeps the distributions whose anisotropic group Blender `version`
+/// builds: GGX, and Beckmann from 3.5 (Cycles 3.0–3.4 sample another lobe than they
+/// evaluate); a distribution named outright that has none is an error.
+fn with_groups(
+    v: &VerifyOptions,
+    distributions: Vec<Distribution>,
+    version: BlenderVersion,
+) -> Result<Vec<Distribution>, Error> {
+    if v.mode != Mode::Anisotropic {
+        return Ok(distributions);
+    }
+    let has_group =
+        |d: Distribution| d != Distribution::AshikhminShirley && version.renders_anisotropic(d);
+    if let Some(&d) = v.distributions.iter().find(|&&d| !has_group(d)) {
+        return Err(Error::input(
+            Field::Distribution,
+            d.key(),
+            format!(
+                "ggx{} (Blender {version} has no anisotropic group of {})",
+                if has_group(Distribution::Beckmann) {
+                    " or beckmann"
+                } else {
+                    ""
+                },
+                d.label()
+            ),
+        ));
+    }
+    Ok(distributions
+        .into_iter()
+        .filter(|&d| has_group(d))
+        .collect())
 }
 
 /// The distributions to check (all in the coefficients unless some are named), each of

@@ -104,6 +104,7 @@ mod tests {
     use crate::fit::Coefficients;
     use crate::generate::{ColorModel, Mode};
     use crate::measure::{Distribution, Masking, Roughness};
+    use crate::verify::plan::Block;
     use crate::verify::stats::SphereStats;
 
     fn version(v: &str) -> BlenderVersion {
@@ -118,15 +119,15 @@ mod tests {
     fn sweep<'a>(
         (c, source): &'a (Coefficients, &'static str),
         ds: &'a [Distribution],
-        ior: &'a [f64],
+        blocks: &'a [Block],
     ) -> Sweep<'a> {
         Sweep {
             coefficients: c,
             source,
             distributions: ds,
             roughness: &[],
-            ior,
-            mode: if ior.is_empty() {
+            blocks,
+            mode: if blocks.is_empty() {
                 Mode::Roughness
             } else {
                 Mode::Layered
@@ -149,7 +150,7 @@ mod tests {
             id: 0,
             distribution: d,
             roughness: Roughness::new(r).unwrap(),
-            ior: None,
+            block: None,
             uncorrected: stats.clone(),
             corrected: stats,
             target: [1.0; 3],

@@ -2,8 +2,9 @@
 //! row 0 at the top. Each distribution gets an uncorrected row and a corrected row; a final
 //! row holds Blender's own energy-conserving answer as the reference. In layered mode the
 //! rows repeat for every index of refraction, "uncorrected" is the Mix Shader artists build
-//! by hand and the reference is Principled BSDF. In EEVEE a last cell holds a white Diffuse
-//! sphere: how bright EEVEE's lighting itself is.
+//! by hand and the reference is Principled BSDF; in anisotropic mode they repeat for every
+//! anisotropy, each sphere's tangent the constant world X. In EEVEE a last cell holds a
+//! white Diffuse sphere: how bright EEVEE's lighting itself is.
 
 use serde::Serialize;
 use std::path::Path;
@@ -41,6 +42,40 @@ impl Role {
     }
 }
 
+/// What a block of verify rows holds fixed besides distribution and roughness: the coat's
+/// index of refraction (layered mode) or the lobe's anisotropy (anisotropic mode). A report
+/// shows it as its own field (`"ior": 1.5`, `"anisotropy": 0.9`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Block {
+    Ior(f64),
+    Anisotropy(f64),
+}
+
+impl Block {
+    pub fn ior(self) -> Option<f64> {
+        match self {
+            Block::Ior(n) => Some(n),
+            Block::Anisotropy(_) => None,
+        }
+    }
+
+    pub fn anisotropy(self) -> Option<f64> {
+        match self {
+            Block::Anisotropy(a) => Some(a),
+            Block::Ior(_) => None,
+        }
+    }
+
+    /// `IOR 1.5`, `anisotropy 0.9`.
+    pub fn label(self) -> String {
+        match self {
+            Block::Ior(n) => format!("IOR {n}"),
+            Block::Anisotropy(a) => format!("anisotropy {a}"),
+        }
+    }
+}
+
 /// The reference spheres' shader in `mode`.
 pub fn reference_label(mode: Mode) -> &'static str {
     match mode {
@@ -49,13 +84,12 @@ pub fn reference_label(mode: Mode) -> &'static str {
     }
 }
 
-/// The index of every block of rows: each of `ior` (layered mode), or one block with no
-/// index when `ior` is empty.
-pub fn ior_slots(ior: &[f64]) -> Vec<Option<f64>> {
-    if ior.is_empty() {
+/// Every block of rows: each of `blocks`, or one plain block when there are none.
+pub fn block_slots(blocks: &[Block]) -> Vec<Option<Block>> {
+    if blocks.is_empty() {
         vec![None]
     } else {
-        ior.iter().copied().map(Some).collect()
+        blocks.iter().copied().map(Some).collect()
     }
 }
 
@@ -63,28 +97,29 @@ pub fn ior_slots(ior: &[f64]) -> Vec<Option<f64>> {
 pub struct Cell {
     pub role: Role,
     pub roughness: Roughness,
-    /// The coat's index of refraction (layered mode only).
-    pub ior: Option<f64>,
+    /// The coat's index or the lobe's anisotropy (layered and anisotropic mode only).
+    pub block: Option<Block>,
 }
 
-/// One row of the verdict: a distribution at one roughness (and, in layered mode, one
-/// index of refraction), and the cells of its uncorrected and corrected spheres. Its `id`
+/// One row of the verdict: a distribution at one roughness (and, in layered and
+/// anisotropic mode, one block's index or anisotropy), and the cells of its uncorrected and corrected spheres. Its `id`
 /// is its place in [`Plan::rows`]; the verdict's row carries it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlanRow {
     pub id: usize,
     pub distribution: Distribution,
     pub roughness: Roughness,
-    pub ior: Option<f64>,
+    pub block: Option<Block>,
     pub uncorrected: usize,
     pub corrected: usize,
 }
 
-/// A reference sphere of the sweep (Multiscatter GGX, or Principled BSDF at `ior`).
+/// A reference sphere of the sweep (Multiscatter GGX, at the block's anisotropy, or
+/// Principled BSDF at the block's index).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlanReference {
     pub roughness: Roughness,
-    pub ior: Option<f64>,
+    pub block: Option<Block>,
     pub cell: usize,
 }
 
@@ -143,19 +178,19 @@ pub struct Plan {
 
 impl Plan {
     /// The verify sweep: for each distribution (in `groups` order) an uncorrected row and a
-    /// corrected row over `roughness`, then the reference row; all of it once per index in
-    /// `ior` (layered mode), or once with no index when `ior` is empty.
+    /// corrected row over `roughness`, then the reference row; all of it once per block in
+    /// `blocks` (layered and anisotropic mode), or once when `blocks` is empty.
     pub fn verify(
         distributions: &[Distribution],
         roughness: &[Roughness],
-        ior: &[f64],
+        blocks: &[Block],
         settings: RenderSettings,
     ) -> Self {
         let columns = roughness.len();
-        // Each index's block of image rows: two per distribution, then the reference.
-        let block = 2 * distributions.len() + 1;
+        // Each block of image rows: two per distribution, then the reference.
+        let block_rows = 2 * distributions.len() + 1;
         let mut plan = Plan::of(Vec::new(), columns, settings);
-        for (b, ior) in ior_slots(ior).into_iter().enumerate() {
+        for (b, block) in block_slots(blocks).into_iter().enumerate() {
             let roles = distributions
                 .iter()
                 .flat_map(|&d| [Role::Uncorrected(d), Role::Corrected(d)])
@@ -164,17 +199,17 @@ impl Plan {
                 plan.cells.extend(roughness.iter().map(|&r| Cell {
                     role,
                     roughness: r,
-                    ior,
+                    block,
                 }));
             }
-            let cell = |line: usize, column: usize| (b * block + line) * columns + column;
+            let cell = |line: usize, column: usize| (b * block_rows + line) * columns + column;
             for (k, &d) in distributions.iter().enumerate() {
                 for (c, &r) in roughness.iter().enumerate() {
                     plan.rows.push(PlanRow {
                         id: plan.rows.len(),
                         distribution: d,
                         roughness: r,
-                        ior,
+                        block,
                         uncorrected: cell(2 * k, c),
                         corrected: cell(2 * k + 1, c),
                     });
@@ -183,8 +218,8 @@ impl Plan {
             plan.references
                 .extend(roughness.iter().enumerate().map(|(c, &r)| PlanReference {
                     roughness: r,
-                    ior,
-                    cell: cell(block - 1, c),
+                    block,
+                    cell: cell(block_rows - 1, c),
                 }));
         }
         plan.with_lighting()
@@ -207,7 +242,7 @@ impl Plan {
             self.cells.push(Cell {
                 role: Role::Lighting,
                 roughness: Roughness::new(0.0).expect("0 is a roughness"),
-                ior: None,
+                block: None,
             });
         }
         self
@@ -230,7 +265,7 @@ impl Plan {
                 roughness.iter().map(move |&r| Cell {
                     role: Role::Uncorrected(d),
                     roughness: r,
-                    ior: None,
+                    block: None,
                 })
             })
             .collect();
@@ -263,32 +298,38 @@ impl Plan {
         let spheres = self
             .cells
             .iter()
-            .map(|c| match (c.role, c.ior) {
-                (Role::Uncorrected(d), Some(ior)) => SphereSpec::Mix {
-                    distribution: d.blender_enum(),
-                    roughness: c.roughness,
-                    ior,
-                },
-                (Role::Uncorrected(d), None) => SphereSpec::Plain {
-                    distribution: d.blender_enum(),
-                    roughness: c.roughness,
-                },
-                (Role::Reference, Some(ior)) => SphereSpec::Principled {
-                    roughness: c.roughness,
-                    ior,
-                },
-                (Role::Reference, None) => SphereSpec::Plain {
-                    distribution: "MULTI_GGX",
-                    roughness: c.roughness,
-                },
-                (Role::Lighting, _) => SphereSpec::Diffuse {
-                    roughness: c.roughness,
-                },
-                (Role::Corrected(d), ior) => SphereSpec::Group {
-                    group: shader_of(d),
-                    roughness: c.roughness,
-                    ior,
-                },
+            .map(|c| {
+                let anisotropy = c.block.and_then(Block::anisotropy);
+                match (c.role, c.block.and_then(Block::ior)) {
+                    (Role::Uncorrected(d), Some(ior)) => SphereSpec::Mix {
+                        distribution: d.blender_enum(),
+                        roughness: c.roughness,
+                        ior,
+                    },
+                    (Role::Uncorrected(d), None) => SphereSpec::Plain {
+                        distribution: d.blender_enum(),
+                        roughness: c.roughness,
+                        anisotropy,
+                    },
+                    (Role::Reference, Some(ior)) => SphereSpec::Principled {
+                        roughness: c.roughness,
+                        ior,
+                    },
+                    (Role::Reference, None) => SphereSpec::Plain {
+                        distribution: "MULTI_GGX",
+                        roughness: c.roughness,
+                        anisotropy,
+                    },
+                    (Role::Lighting, _) => SphereSpec::Diffuse {
+                        roughness: c.roughness,
+                    },
+                    (Role::Corrected(d), ior) => SphereSpec::Group {
+                        group: shader_of(d),
+                        roughness: c.roughness,
+                        ior,
+                        anisotropy,
+                    },
+                }
             })
             .collect();
         FurnaceParams {
@@ -312,15 +353,23 @@ impl Plan {
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "shader", rename_all = "kebab-case")]
 pub enum SphereSpec {
+    /// A Glossy BSDF (with an anisotropy: Blender's anisotropic glossy, its tangent the
+    /// constant world X).
     Plain {
         distribution: &'static str,
         roughness: Roughness,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        anisotropy: Option<f64>,
     },
+    /// A gloffuse group (the layered groups take an index, the anisotropic ones an
+    /// anisotropy and the constant world X as their tangent).
     Group {
         group: String,
         roughness: Roughness,
         #[serde(skip_serializing_if = "Option::is_none")]
         ior: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        anisotropy: Option<f64>,
     },
     /// Mix Shader(Fac = Fresnel(ior), Diffuse, white Glossy of `distribution`).
     Mix {
@@ -371,7 +420,8 @@ mod tests {
     fn rows_name_their_cells() {
         let roughness = rs(&[0.0, 0.5, 1.0]);
         let ds = [Distribution::Ggx, Distribution::Beckmann];
-        let plan = Plan::verify(&ds, &roughness, &[1.33, 1.5], RenderSettings::default());
+        let blocks = [Block::Ior(1.33), Block::Anisotropy(0.5)];
+        let plan = Plan::verify(&ds, &roughness, &blocks, RenderSettings::default());
         assert_eq!(plan.rows.len(), 2 * ds.len() * roughness.len());
         assert_eq!(plan.references.len(), 2 * roughness.len());
         for (i, row) in plan.rows.iter().enumerate() {
@@ -379,7 +429,7 @@ mod tests {
             let expect = |role| Cell {
                 role,
                 roughness: row.roughness,
-                ior: row.ior,
+                block: row.block,
             };
             assert_eq!(
                 plan.cells[row.uncorrected],
@@ -394,16 +444,16 @@ mod tests {
         let order: Vec<_> = plan
             .rows
             .iter()
-            .map(|r| (r.ior, r.distribution, r.roughness.get()))
+            .map(|r| (r.block, r.distribution, r.roughness.get()))
             .collect();
-        assert_eq!(order[0], (Some(1.33), Distribution::Ggx, 0.0));
-        assert_eq!(order[4], (Some(1.33), Distribution::Beckmann, 0.5));
-        assert_eq!(order[6], (Some(1.5), Distribution::Ggx, 0.0));
+        assert_eq!(order[0], (Some(blocks[0]), Distribution::Ggx, 0.0));
+        assert_eq!(order[4], (Some(blocks[0]), Distribution::Beckmann, 0.5));
+        assert_eq!(order[6], (Some(blocks[1]), Distribution::Ggx, 0.0));
         for r in &plan.references {
             let c = &plan.cells[r.cell];
             assert_eq!(
-                (c.role, c.roughness, c.ior),
-                (Role::Reference, r.roughness, r.ior)
+                (c.role, c.roughness, c.block),
+                (Role::Reference, r.roughness, r.block)
             );
         }
         // Each cell belongs to one row or reference at most.

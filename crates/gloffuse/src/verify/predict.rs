@@ -2,10 +2,14 @@
 //! looked at: what the colour model promises the spheres (as a whole and ring by ring), and
 //! what the uncorrected and corrected spheres should render relative to that.
 
+use super::plan::Block;
 use crate::fit::Curve;
 use crate::generate::{ColorModel, Mode};
 use crate::measure::coat::{Coat, multiscatter_tint};
-use crate::measure::{AlbedoIntegrator, Distribution, Engine, Glossy, Masking, Roughness};
+use crate::measure::{
+    AlbedoIntegrator, AnisotropicIntegrator, AnisotropicLobe, Anisotropy, Distribution, Engine,
+    Glossy, Masking, Roughness,
+};
 
 /// What a sweep's predictions depend on besides the row: the engines, the masking of the
 /// Blender used, the correction mode and the colour.
@@ -21,10 +25,11 @@ pub struct Predictor {
     pub color_model: ColorModel,
 }
 
-/// What the integrator predicts for one (distribution, roughness, index) row.
+/// What the integrator predicts for one (distribution, roughness, block) row.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prediction {
-    /// E_avg(r) of the BSDF the engine renders (layered mode: of the coat).
+    /// E_avg(r) of the BSDF the engine renders (layered mode: of the coat; anisotropic
+    /// mode: the mean of E(μ, φ) over the sphere, whose tangent is the world X).
     pub e_avg: f64,
     /// What the colour model promises the corrected sphere's mean, per channel.
     pub target: [f64; 3],
@@ -43,16 +48,21 @@ pub struct Prediction {
 }
 
 impl Predictor {
-    /// The prediction for `d` at `r` (and coat index `ior`), with `curve` the coefficients'
-    /// curve of `d` and `rings` the view-cosine intervals of the corrected sphere's rings.
+    /// The prediction for `d` at `r` (and the block's coat index or anisotropy), with
+    /// `curve` the coefficients' curve of `d` and `rings` the view-cosine intervals of the
+    /// corrected sphere's rings.
     pub fn predict(
         &self,
         curve: &Curve,
         d: Distribution,
         r: Roughness,
-        ior: Option<f64>,
+        block: Option<Block>,
         rings: &[(f64, f64)],
     ) -> Prediction {
+        if let Some(a) = block.and_then(Block::anisotropy) {
+            return self.predict_anisotropic(d, r, a, rings.len());
+        }
+        let ior = block.and_then(Block::ior);
         let i = &self.integrator;
         let glossy = self.engine.glossy(d, self.masking, r);
         let coat = ior.map(|n| Coat::new(i, glossy, n));
@@ -96,6 +106,30 @@ impl Predictor {
         }
     }
 
+    /// An anisotropic row (exact colour, Cycles): the corrected sphere and every ring at the
+    /// colour, the uncorrected sphere at the mean of E(μ, φ) over its disk.
+    fn predict_anisotropic(
+        &self,
+        d: Distribution,
+        r: Roughness,
+        anisotropy: f64,
+        rings: usize,
+    ) -> Prediction {
+        let a = Anisotropy::new(anisotropy).expect("verify checks the anisotropy");
+        let lobe = AnisotropicLobe::from_glossy_node(d, self.masking, r, a)
+            .expect("verify sweeps the distributions with an anisotropic lobe");
+        let e_avg = AnisotropicIntegrator::default().constant_tangent_sphere_mean(&lobe);
+        Prediction {
+            e_avg,
+            target: self.color,
+            ring_targets: vec![self.color; rings],
+            uncorrected_base: self.color,
+            uncorrected: e_avg,
+            corrected: 1.0,
+            cycles_uncorrected: None,
+        }
+    }
+
     /// What the corrected sphere renders relative to `target`: the roughness-only gain's
     /// result, or in the view modes 1 unless the groups are calibrated for another engine's
     /// BSDF (`calibrated`) than the one rendered (`glossy`).
@@ -130,11 +164,12 @@ impl Predictor {
         }
     }
 
-    /// What the reference sphere at `r` promises: Multiscatter GGX what a corrected GGX
-    /// sphere does, Principled BSDF (at `ior`) what a layered GGX coat does.
-    pub fn reference_target(&self, r: Roughness, ior: Option<f64>) -> [f64; 3] {
+    /// What the reference sphere at `r` promises: Multiscatter GGX (at any anisotropy)
+    /// what a corrected GGX sphere does, Principled BSDF (at the block's index) what a
+    /// layered GGX coat does.
+    pub fn reference_target(&self, r: Roughness, block: Option<Block>) -> [f64; 3] {
         let ggx = self.engine.glossy(Distribution::Ggx, self.masking, r);
-        match ior {
+        match block.and_then(Block::ior) {
             Some(n) => layered_sphere_target(&Coat::new(&self.integrator, ggx, n), self.color),
             None => {
                 let e_avg = self.integrator.average_albedo(&ggx);

@@ -4,6 +4,7 @@
 
 use serde::{Serialize, Serializer};
 
+use super::plan::Block;
 use super::render::RenderInfo;
 use super::stats::SphereStats;
 use crate::fit::Coefficients;
@@ -58,9 +59,10 @@ pub struct Row {
     pub id: usize,
     pub distribution: Distribution,
     pub roughness: Roughness,
-    /// The coat's index of refraction (layered mode only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ior: Option<f64>,
+    /// The coat's index of refraction (layered mode) or the lobe's anisotropy (anisotropic
+    /// mode), as the field `ior` or `anisotropy`.
+    #[serde(flatten)]
+    pub block: Option<Block>,
     pub uncorrected: SphereStats,
     pub corrected: SphereStats,
     /// What the colour model promises the corrected sphere's mean is, per channel: the
@@ -95,17 +97,17 @@ pub struct Row {
 }
 
 /// `GGX`, or in layered mode `GGX, IOR 1.5`: the name of a row's series.
-fn series_name(name: &str, ior: Option<f64>) -> String {
-    match ior {
-        Some(n) => format!("{name}, IOR {n}"),
+fn series_name(name: &str, block: Option<Block>) -> String {
+    match block {
+        Some(b) => format!("{name}, {}", b.label()),
         None => name.to_string(),
     }
 }
 
 impl Row {
-    /// The distribution, and the index of refraction in layered mode: `GGX, IOR 1.5`.
+    /// The distribution, and the block's index or anisotropy: `GGX, IOR 1.5`.
     pub fn series(&self) -> String {
-        series_name(self.distribution.label(), self.ior)
+        series_name(self.distribution.label(), self.block)
     }
 }
 
@@ -114,8 +116,8 @@ impl Row {
 #[derive(Clone, Debug, Serialize)]
 pub struct ReferenceSphere {
     pub roughness: Roughness,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ior: Option<f64>,
+    #[serde(flatten)]
+    pub block: Option<Block>,
     /// Where the sphere is in the plan's cells.
     #[serde(skip)]
     pub cell: usize,
@@ -128,7 +130,7 @@ pub struct ReferenceSphere {
 impl ReferenceSphere {
     /// `Multiscatter GGX`, or in layered mode `Principled BSDF, IOR 1.5`.
     pub fn series(&self, mode: Mode) -> String {
-        series_name(super::plan::reference_label(mode), self.ior)
+        series_name(super::plan::reference_label(mode), self.block)
     }
 }
 
@@ -235,8 +237,9 @@ pub struct Sweep<'a> {
     pub source: &'a str,
     pub distributions: &'a [Distribution],
     pub roughness: &'a [Roughness],
-    /// Layered mode: the indices of refraction (else empty).
-    pub ior: &'a [f64],
+    /// Layered mode: the indices of refraction; anisotropic mode: the anisotropies (else
+    /// empty).
+    pub blocks: &'a [Block],
     pub mode: Mode,
     /// The spheres' colour and what a correction promises for it.
     pub color: [f64; 3],
