@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::blender::{real_blender, run_in_blender};
+use common::blender::{real_blender, render_cases, run_in_blender};
 use glam::DVec3;
 use gloffuse::measure::anisotropic::{local_direction, view};
 use gloffuse::measure::{
@@ -51,45 +51,6 @@ fn local_view(col: usize, row: usize) -> Option<DVec3> {
     Some(local_direction(normal, tangent, to_camera))
 }
 
-/// Renders the spheres `request` asks for (see `tests/blender/anisotropic_sphere.py`) in
-/// the real Blender `label`: each render's pixels, bottom row first; none when that
-/// Blender is missing and skipping was asked for.
-fn render_spheres(label: &str, request: &serde_json::Value) -> Option<Vec<Vec<f64>>> {
-    let blender = real_blender(label)?;
-    let dir = tempfile::tempdir().unwrap();
-    let (request_path, out) = (dir.path().join("cases.json"), dir.path().join("out.json"));
-    std::fs::write(&request_path, request.to_string()).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/anisotropic_sphere.py");
-    let output = run_in_blender(
-        &blender,
-        &script,
-        &[request_path.as_os_str(), out.as_os_str()],
-    );
-    assert!(
-        output.status.success() && out.exists(),
-        "Blender {label}: {}\n{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let result: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-    let renders: Vec<Vec<f64>> = result["renders"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|render| {
-            render
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_f64().unwrap())
-                .collect()
-        })
-        .collect();
-    assert!(renders.iter().all(|pixels| pixels.len() == PX * PX));
-    Some(renders)
-}
-
 fn check(label: &str, version: &str, cases: &[Case]) {
     let request = serde_json::json!({
         "px": PX,
@@ -100,7 +61,7 @@ fn check(label: &str, version: &str, cases: &[Case]) {
             "anisotropy": c.anisotropy,
         })).collect::<Vec<_>>(),
     });
-    let Some(renders) = render_spheres(label, &request) else {
+    let Some(renders) = render_cases(label, "anisotropic_sphere.py", &request, PX) else {
         return;
     };
     let masking = version.parse::<BlenderVersion>().unwrap().masking();
@@ -310,7 +271,7 @@ fn the_anisotropic_group_renders_every_ring_at_100_percent() {
         let request = serde_json::json!({
             "px": PX, "samples": 256, "script": script, "cases": request_cases,
         });
-        let Some(renders) = render_spheres(label, &request) else {
+        let Some(renders) = render_cases(label, "anisotropic_sphere.py", &request, PX) else {
             continue;
         };
         for (&(group, (r, a, t)), pixels) in cases.iter().zip(&renders) {

@@ -95,3 +95,50 @@ pub fn run_in_blender(
         .output()
         .expect("Blender starts")
 }
+
+/// Runs `tests/blender/<script>` with the cases `request` asks for in the real Blender
+/// `label` (the script writes `{"renders": [[R of every pixel, bottom row first], …]}`):
+/// each render's `px × px` pixels; none when that Blender is missing and skipping was asked
+/// for.
+pub fn render_cases(
+    label: &str,
+    script: &str,
+    request: &serde_json::Value,
+    px: usize,
+) -> Option<Vec<Vec<f64>>> {
+    let blender = real_blender(label)?;
+    let dir = tempfile::tempdir().unwrap();
+    let (request_path, out) = (dir.path().join("cases.json"), dir.path().join("out.json"));
+    std::fs::write(&request_path, request.to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/blender")
+        .join(script);
+    let output = run_in_blender(
+        &blender,
+        &script,
+        &[request_path.as_os_str(), out.as_os_str()],
+    );
+    assert!(
+        output.status.success() && out.exists(),
+        "Blender {label}: {}\n{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let renders: Vec<Vec<f64>> = result["renders"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|render| {
+            render
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect()
+        })
+        .collect();
+    assert!(renders.iter().all(|pixels| pixels.len() == px * px));
+    Some(renders)
+}

@@ -3,12 +3,14 @@
 //! and its albedo (`anisotropic`), the masking family of each Blender version (`version`),
 //! the BSDF each render engine evaluates (`engine`), the normal a glossy BSDF shades with
 //! (`shading_normal`), the dielectric Fresnel (`fresnel`) and the coat of the layered shader
-//! (`coat`), and the classic BRDF set (`brdf`).
+//! (`coat`), the Glass and Refraction BSDFs and their albedo (`dielectric`), and the classic
+//! BRDF set (`brdf`).
 
 pub mod albedo;
 pub mod anisotropic;
 pub mod brdf;
 pub mod coat;
+pub mod dielectric;
 pub mod engine;
 pub mod fresnel;
 pub mod glossy;
@@ -18,6 +20,7 @@ pub mod version;
 
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
 pub use anisotropic::{AnisotropicIntegrator, AnisotropicLobe, Anisotropy};
+pub use dielectric::{Dielectric, DielectricIntegrator, DielectricNode, GlassForm};
 pub use engine::Engine;
 pub use glossy::Glossy;
 pub use microfacet::{Distribution, Masking, Microfacet, Polar, Roughness};

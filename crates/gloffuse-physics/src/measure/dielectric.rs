@@ -1,0 +1,277 @@
+//! Blender's Glass and Refraction BSDFs (GGX, Beckmann) as Cycles samples them for a white
+//! colour, and their directional albedo `E(μ, r, η)`: what one interface returns of the
+//! light that meets it, reflected and transmitted together.
+//!
+//! η is the index on the far side over the index on the viewer's side: the node's IOR on a
+//! front face, 1/IOR on a back face (Cycles flips the normal to face the viewer there), so
+//! the albedo of a glass interface seen from inside is `E(μ, r, 1/IOR)`. Cycles applies no
+//! 1/η² to transmitted radiance. Two forms, read in Cycles' `svm/closure.h` and
+//! `closure/bsdf_microfacet.h` (docs/PHYSICS.md §15):
+//! - **Blender 3.0–3.5** ([`GlassForm::TwoClosures`]): the Glass node is two closures, a
+//!   reflection lobe weighted by the Fresnel at the shading normal `F(μ)` and a refraction
+//!   lobe weighted by `max(1e-4, 1 − F(μ))`, neither with a Fresnel of its own. A microfacet
+//!   that would reflect totally ends the path: its light is lost.
+//! - **Blender 3.6 on** ([`GlassForm::OneClosure`]): one closure that reflects with the
+//!   Fresnel of each microfacet `F(v·h)` and refracts with `1 − F(v·h)`; a microfacet that
+//!   reflects totally reflects.
+//!
+//! The Refraction node is the transmitted lobe alone, without a Fresnel (a microfacet that
+//! would reflect totally ends the path), in every version. Each lobe has the masking family
+//! of its version. A reflection the sampler sends below the surface ends the path; so does
+//! a refraction sent above it from 3.6 on (3.0–3.5 keep it: it leaves as it is).
+//!
+//! The albedo is what Cycles' sampler returns on average: an integral over the visible
+//! microfacet normals, `∫ G1(v) (v·h)⁺ D(h) / μ · w(h) dh`, with `w` the sample's weight (a
+//! lobe's `G2/G1(v)`, times its Fresnel). Cycles' own evaluation also gives a value to pairs
+//! of directions no microfacet connects (its source says the check is missing), which only
+//! light sampling reaches; the sampler, and Cycles' own `ggx_glass_E` tables, do not.
+
+use glam::DVec3;
+use std::f64::consts::PI;
+
+use super::albedo::gauss_unit;
+use super::fresnel;
+use super::microfacet::{Distribution, Masking, Microfacet, Roughness};
+use super::version::BlenderVersion;
+
+/// Which node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DielectricNode {
+    /// Glass BSDF: reflection and refraction.
+    Glass,
+    /// Refraction BSDF: the refracted lobe alone.
+    Refraction,
+}
+
+/// How Cycles builds and samples a rough dielectric (Blender version dependent).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GlassForm {
+    /// Blender 3.0–3.5: Glass is two closures weighted by the Fresnel at the shading
+    /// normal; the refraction sampler keeps a direction that leaves upwards.
+    TwoClosures,
+    /// Blender 3.6 on: one closure with the Fresnel of each microfacet; a refraction that
+    /// leaves upwards ends the path.
+    OneClosure,
+}
+
+impl GlassForm {
+    /// The first Blender whose Glass node is one closure with a per-microfacet Fresnel
+    /// (Cycles v3.6.0; v3.5.0 still allocates two in `svm/closure.h`).
+    pub const ONE_CLOSURE_FROM: BlenderVersion = BlenderVersion { major: 3, minor: 6 };
+
+    pub fn of(version: BlenderVersion) -> Self {
+        if version >= Self::ONE_CLOSURE_FROM {
+            GlassForm::OneClosure
+        } else {
+            GlassForm::TwoClosures
+        }
+    }
+}
+
+/// One Glass or Refraction BSDF configuration of a Blender version, white.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dielectric {
+    pub node: DielectricNode,
+    pub microfacet: Microfacet,
+    pub masking: Masking,
+    pub form: GlassForm,
+}
+
+/// How one direction leaves a microfacet of the sampler.
+enum Scatter {
+    /// Away from the surface (reflection) or into it (refraction): its `G2/G1(v)`.
+    Kept(f64),
+    /// To the wrong side of the surface: the path ends.
+    Lost,
+}
+
+impl Dielectric {
+    /// The node of `distribution` (GGX or Beckmann) at `roughness` as Blender `version`
+    /// renders it.
+    pub fn new(
+        node: DielectricNode,
+        distribution: Distribution,
+        roughness: Roughness,
+        version: BlenderVersion,
+    ) -> Self {
+        Dielectric {
+            node,
+            microfacet: Microfacet::new(distribution, roughness),
+            masking: version.masking(),
+            form: GlassForm::of(version),
+        }
+    }
+
+    /// Cycles samples a lobe this narrow as a perfect interface (`αx αy ≤ 1e-7` before the
+    /// 3.6 rewrite, `≤ 2e-10` after).
+    fn is_smooth(&self) -> bool {
+        let a2 = self.microfacet.alpha * self.microfacet.alpha;
+        a2 <= match self.form {
+            GlassForm::TwoClosures => 1e-7,
+            GlassForm::OneClosure => 2e-10,
+        }
+    }
+
+    /// `G2(v, l) / G1(v)` for the direction `l` leaving a microfacet, if the sampler keeps
+    /// it: a reflection above the surface; a refraction below it, or from Blender 3.0–3.5's
+    /// sampler, which does not check the side of a refracted direction, anywhere (one that
+    /// leaves upwards goes on as it is).
+    fn leave(&self, lambda_v: f64, l: DVec3, reflected: bool) -> Scatter {
+        let wrong_side = if reflected {
+            l.z <= 0.0
+        } else {
+            l.z >= 0.0 && self.form == GlassForm::OneClosure
+        };
+        if wrong_side || l.z == 0.0 {
+            return Scatter::Lost;
+        }
+        let lambda_l = self.microfacet.lambda(l.z.abs());
+        Scatter::Kept(self.masking.g2(lambda_v, lambda_l) * (1.0 + lambda_v))
+    }
+
+    /// The weight of a sample through the microfacet `h` (unit, `h.z > 0`, `v·h > 0`) for
+    /// the view `v` at index `eta`, by lobe: `(reflection, refraction)`, each without the
+    /// macro Fresnel of [`GlassForm::TwoClosures`] (the caller weights the two lobes).
+    fn lobes(&self, v: DVec3, h: DVec3, eta: f64, lambda_v: f64) -> (f64, f64) {
+        let c = v.dot(h);
+        let kept = |s: Scatter| match s {
+            Scatter::Kept(g) => g,
+            Scatter::Lost => 0.0,
+        };
+        let reflection = || kept(self.leave(lambda_v, 2.0 * c * h - v, true));
+        // Snell at the microfacet: sin²θt = (1 − c²)/η²; none when that exceeds 1.
+        let sin2_t = (1.0 - c * c) / (eta * eta);
+        let refraction = || {
+            if sin2_t >= 1.0 {
+                return 0.0;
+            }
+            let cos_t = (1.0 - sin2_t).sqrt();
+            let t = (c / eta - cos_t) * h - v / eta;
+            kept(self.leave(lambda_v, t, false))
+        };
+        match (self.node, self.form) {
+            (DielectricNode::Refraction, _) => (0.0, refraction()),
+            (DielectricNode::Glass, GlassForm::TwoClosures) => (reflection(), refraction()),
+            (DielectricNode::Glass, GlassForm::OneClosure) => {
+                let f = fresnel::dielectric(c, eta);
+                (f * reflection(), (1.0 - f) * refraction())
+            }
+        }
+    }
+}
+
+/// Numbers of quadrature nodes for [`DielectricIntegrator`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DielectricQuadrature {
+    /// Along the microfacets' polar angle, by lobe mass.
+    pub polar: usize,
+    /// Along their azimuth, over the half circle the view sees.
+    pub azimuth: usize,
+}
+
+impl Default for DielectricQuadrature {
+    fn default() -> Self {
+        DielectricQuadrature {
+            polar: 96,
+            azimuth: 64,
+        }
+    }
+}
+
+/// Computes `E(μ, r, η)` of a [`Dielectric`] by Gauss–Legendre quadrature over the visible
+/// microfacet normals.
+#[derive(Clone, Debug)]
+pub struct DielectricIntegrator {
+    polar: Vec<(f64, f64)>,
+    azimuth: Vec<(f64, f64)>,
+}
+
+impl Default for DielectricIntegrator {
+    fn default() -> Self {
+        DielectricIntegrator::new(DielectricQuadrature::default())
+    }
+}
+
+impl DielectricIntegrator {
+    pub fn new(q: DielectricQuadrature) -> Self {
+        DielectricIntegrator {
+            polar: gauss_unit(q.polar),
+            azimuth: gauss_unit(q.azimuth),
+        }
+    }
+
+    /// `E(μ, r, η)`: the white interface's directional albedo for the view cosine `mu`
+    /// (views below 1e-4 of grazing are taken there) at relative index `eta` (> 0).
+    pub fn directional_albedo(&self, bsdf: &Dielectric, mu: f64, eta: f64) -> f64 {
+        let mu = mu.clamp(1e-4, 1.0);
+        let macro_f = fresnel::dielectric(mu, eta);
+        // The weights of the two lobes: 1 each, or in 3.0–3.5's glass the macro Fresnel.
+        let (wr, wt) = match (bsdf.node, bsdf.form) {
+            (DielectricNode::Refraction, _) => (0.0, 1.0),
+            (DielectricNode::Glass, GlassForm::OneClosure) => (1.0, 1.0),
+            (DielectricNode::Glass, GlassForm::TwoClosures) => (macro_f, (1.0 - macro_f).max(1e-4)),
+        };
+        // A smooth interface, or a matched index (Cycles refracts straight through at
+        // |η − 1| < 1e-4): every lobe returns all it is given, except a smooth refraction
+        // past the critical angle.
+        let straight = (eta - 1.0).abs() < 1e-4;
+        if bsdf.is_smooth() || straight {
+            let refracts = straight || (1.0 - mu * mu) < eta * eta;
+            let t = if refracts { 1.0 } else { 0.0 };
+            return match (bsdf.node, bsdf.form) {
+                (DielectricNode::Refraction, _) => t,
+                (DielectricNode::Glass, GlassForm::OneClosure) => 1.0,
+                (DielectricNode::Glass, GlassForm::TwoClosures) => wr + wt * t,
+            };
+        }
+        let v = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+        let m = bsdf.microfacet;
+        let lambda_v = m.lambda(mu);
+        let g1_v = 1.0 / (1.0 + lambda_v);
+        let (mut reflected, mut refracted) = (0.0, 0.0);
+        for &(s, ws) in &self.polar {
+            // h drawn with density D(h) cosθh: its polar angle by the lobe mass beyond it,
+            // s² (GGX's tail has tan θh ∝ 1/s there, which the 2s ds of s² cancels), then
+            // the azimuths the view sees, v·h > 0 ⇔ cos φ > −cot θv cot θh (mirror
+            // symmetric about the view's plane, so one half).
+            let (p, wu) = (m.polar_from_survival(s * s), 2.0 * s * ws);
+            let cos_limit = -mu * p.cos / (v.x * p.sin).max(1e-300);
+            let phi_max = cos_limit.clamp(-1.0, 1.0).acos();
+            if phi_max <= 0.0 {
+                continue;
+            }
+            for &(x, wp) in &self.azimuth {
+                let phi = phi_max * x;
+                let h = DVec3::new(p.sin * phi.cos(), p.sin * phi.sin(), p.cos);
+                let vh = v.dot(h);
+                if vh <= 0.0 {
+                    continue;
+                }
+                // Density D cosθh dω per (u, φ): du dφ / 2π; the visible-normal density
+                // over it is G1(v) (v·h) / (μ cosθh); two mirror halves.
+                let weight = wu * wp * phi_max / PI * g1_v * vh / (mu * p.cos);
+                let (r, t) = bsdf.lobes(v, h, eta, lambda_v);
+                reflected += weight * r;
+                refracted += weight * t;
+            }
+        }
+        wr * reflected + wt * refracted
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(version: &str) -> BlenderVersion {
+        version.parse().unwrap()
+    }
+
+    #[test]
+    fn the_glass_form_changes_in_3_6() {
+        assert_eq!(GlassForm::of(v("3.4")), GlassForm::TwoClosures);
+        assert_eq!(GlassForm::of(v("3.5")), GlassForm::TwoClosures);
+        assert_eq!(GlassForm::of(v("3.6")), GlassForm::OneClosure);
+        assert_eq!(GlassForm::of(v("5.0")), GlassForm::OneClosure);
+    }
+}
