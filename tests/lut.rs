@@ -26,7 +26,7 @@ fn small(kind: Kind, out: &Path, format: Format, bits: Bits) -> LutOptions {
     args.size = Some(match kind {
         Kind::SplitSum => 24,
         Kind::KullaConty | Kind::Albedo | Kind::Coat => 8,
-        Kind::Anisotropic => 4,
+        Kind::Anisotropic | Kind::Glass => 4,
     });
     // Only Kulla–Conty samples: the albedo and coat tables and split-sum's default method
     // are quadrature.
@@ -69,12 +69,13 @@ fn assert_same_texels(found: &[f32], table: &Table, bits: Bits, what: &str) {
     }
 }
 
-const KINDS: [Kind; 5] = [
+const KINDS: [Kind; 6] = [
     Kind::SplitSum,
     Kind::KullaConty,
     Kind::Albedo,
     Kind::Coat,
     Kind::Anisotropic,
+    Kind::Glass,
 ];
 const BITS: [Bits; 2] = [Bits::Half, Bits::Float];
 
@@ -158,12 +159,14 @@ fn dds_reads_back_with_ddsfile() {
             let summary = lut(&args, &Quiet).unwrap();
             let dds = Dds::read(std::fs::File::open(&path).unwrap()).unwrap();
             let expected = match (kind, bits) {
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Half) => {
-                    DxgiFormat::R16G16_Float
-                }
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Float) => {
-                    DxgiFormat::R32G32_Float
-                }
+                (
+                    Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic | Kind::Glass,
+                    Bits::Half,
+                ) => DxgiFormat::R16G16_Float,
+                (
+                    Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic | Kind::Glass,
+                    Bits::Float,
+                ) => DxgiFormat::R32G32_Float,
                 (Kind::KullaConty, Bits::Half) => DxgiFormat::R16G16B16A16_Float,
                 (Kind::KullaConty, Bits::Float) => DxgiFormat::R32G32B32A32_Float,
             };
@@ -203,12 +206,14 @@ fn ktx2_reads_back_with_the_ktx2_crate() {
             let reader = ktx2::Reader::new(&bytes[..]).expect("a valid KTX2 file");
             let header = reader.header();
             let format = match (kind, bits) {
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Half) => {
-                    ktx2::Format::R16G16_SFLOAT
-                }
-                (Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic, Bits::Float) => {
-                    ktx2::Format::R32G32_SFLOAT
-                }
+                (
+                    Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic | Kind::Glass,
+                    Bits::Half,
+                ) => ktx2::Format::R16G16_SFLOAT,
+                (
+                    Kind::SplitSum | Kind::Albedo | Kind::Coat | Kind::Anisotropic | Kind::Glass,
+                    Bits::Float,
+                ) => ktx2::Format::R32G32_SFLOAT,
                 (Kind::KullaConty, Bits::Half) => ktx2::Format::R16G16B16A16_SFLOAT,
                 (Kind::KullaConty, Bits::Float) => ktx2::Format::R32G32B32A32_SFLOAT,
             };
@@ -983,6 +988,79 @@ fn anisotropic_refuses_what_blender_does_not_render() {
     assert!(refused(Distribution::Ggx, "3.0").is_none());
     let mut args = LutOptions::new(Kind::Anisotropic, "x.exr");
     args.size = Some(33);
+    assert!(matches!(
+        Spec::from_options(&args),
+        Err(Error::Input {
+            field: Field::Size,
+            ..
+        })
+    ));
+}
+
+/// The glass atlas holds, at each texel, the integrator's E for that slice's index on that
+/// row's side, Glass in R and Refraction in G; a matched index (slice 0) returns everything,
+/// and the form follows the Blender version (3.4's two closures differ from 4.5's one).
+#[test]
+fn glass_texels_are_the_albedo_of_their_slice_and_side() {
+    use gloffuse::measure::coat::{SLICES, slice_iors};
+    use gloffuse::measure::{Dielectric, DielectricIntegrator, DielectricNode, Roughness};
+    let n = 4;
+    let table_of = |v: &str| {
+        let mut args = LutOptions::new(Kind::Glass, "x.exr");
+        args.size = Some(n as u32);
+        args.blender_version = Some(v.parse().unwrap());
+        args.distribution = Some(Distribution::Beckmann);
+        Spec::from_options(&args).unwrap().compute(&Quiet)
+    };
+    let table = table_of("4.5");
+    assert_eq!((table.width, table.height), (SLICES * n, 2 * n));
+    let q = DielectricIntegrator::default();
+    let ior = slice_iors();
+    let version = "4.5".parse().unwrap();
+    for (side, flip) in [(0, false), (1, true)] {
+        for k in [0, 5, SLICES - 1] {
+            let eta = if flip { 1.0 / ior[k] } else { ior[k] };
+            for (x, y) in [(0, 0), (3, 1), (2, 3)] {
+                let r = Roughness::new(coord(x, n)).unwrap();
+                let texel = (k * n + x, side * n + y);
+                for (c, node) in [DielectricNode::Glass, DielectricNode::Refraction]
+                    .into_iter()
+                    .enumerate()
+                {
+                    let bsdf = Dielectric::new(node, Distribution::Beckmann, r, version);
+                    let e = q.directional_albedo(&bsdf, coord(y, n), eta) as f32;
+                    let found = table.get(texel.0, texel.1, c);
+                    assert_eq!(
+                        found, e,
+                        "slice {k} side {side} texel {texel:?} channel {c}"
+                    );
+                    if k == 0 {
+                        assert_eq!(found, 1.0, "a matched index returns everything");
+                    }
+                }
+            }
+        }
+    }
+    let old = table_of("3.4");
+    let farthest = (0..table.data.len())
+        .map(|i| (table.data[i] - old.data[i]).abs())
+        .fold(0.0f32, f32::max);
+    assert!(farthest > 0.05, "3.4's glass is another form: {farthest}");
+}
+
+#[test]
+fn glass_refuses_ashikhmin_shirley_and_oversized_atlases() {
+    let mut args = LutOptions::new(Kind::Glass, "x.exr");
+    args.distribution = Some(Distribution::AshikhminShirley);
+    assert!(matches!(
+        Spec::from_options(&args),
+        Err(Error::Input {
+            field: Field::Distribution,
+            ..
+        })
+    ));
+    let mut args = LutOptions::new(Kind::Glass, "x.exr");
+    args.size = Some(257);
     assert!(matches!(
         Spec::from_options(&args),
         Err(Error::Input {

@@ -273,6 +273,10 @@ const KINDS: &[Choice<Kind>] = &[
         Kind::Anisotropic,
         "Cycles' anisotropic GGX or Beckmann lobe: 16 view azimuths × --size bitangent widths of slices at grid points (R = E(μ, φ, αx, αy), G = E_avg(αx, αy))",
     ),
+    choice(
+        Kind::Glass,
+        "Cycles' Glass and Refraction BSDFs: 12 IOR slices side by side, light entering (top row) and leaving (bottom row) (R = E(μ, r, η) of Glass, G = of Refraction)",
+    ),
 ];
 
 const G_MODELS: &[Choice<GModel>] = &[
@@ -1051,19 +1055,19 @@ impl BenchArgs {
 /// Texel (x, y) holds roughness (x + ½)/n and N·V = (y + ½)/n; sample at uv = (roughness, N·V).
 #[derive(Args, Debug, Clone, PartialEq)]
 pub struct LutArgs {
-    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G); coat: A(μ, r, IOR), E(μ, r) (R, G) in 12 slices of IOR 1 to 3 side by side; anisotropic: E(μ, φ, αx, αy), E_avg(αx, αy) (R, G) in slices over the view azimuth and the bitangent width.
+    /// split-sum: GGX scale and bias (R, G); kulla-conty: scale, bias, ∫f_ms cos, E_avg (RGBA); albedo: E(μ, r), E_avg(r) (R, G); coat: A(μ, r, IOR), E(μ, r) (R, G) in 12 slices of IOR 1 to 3 side by side; anisotropic: E(μ, φ, αx, αy), E_avg(αx, αy) (R, G) in slices over the view azimuth and the bitangent width; glass: E(μ, r, η) of the Glass and Refraction BSDFs (R, G) in 12 slices of IOR 1 to 3, light entering (top row) and leaving (bottom row).
     #[arg(long, value_parser = one_of(KINDS, Kind::key), default_value = Kind::SplitSum.key())]
     pub kind: Kind,
 
-    /// kulla-conty, albedo and coat: beckmann, ggx or ashikhmin-shirley; anisotropic: beckmann or ggx [default: ggx].
+    /// kulla-conty, albedo and coat: beckmann, ggx or ashikhmin-shirley; anisotropic and glass: beckmann or ggx [default: ggx].
     #[arg(long, short = 'd', value_parser = parse_distribution)]
     pub distribution: Option<Distribution>,
 
-    /// kulla-conty, albedo, coat and anisotropic: the Blender whose masking the BSDF follows (3.0–3.4 separable, 3.5+ height-correlated) [default: 4.5].
+    /// kulla-conty, albedo, coat, anisotropic and glass: the Blender whose BSDF the table follows (masking: 3.0–3.4 separable, 3.5+ height-correlated; glass: 3.0–3.5 two closures, 3.6+ one) [default: 4.5].
     #[arg(long, value_parser = parse_version)]
     pub blender_version: Option<BlenderVersion>,
 
-    /// Texels per side (per slice for coat and anisotropic), 1 to 8192 (coat 1024, anisotropic 2 to 32) [default: 512 for split-sum, 16 for anisotropic, 64 otherwise].
+    /// Texels per side (per slice for coat, anisotropic and glass), 1 to 8192 (coat 1024, anisotropic 2 to 32, glass 256) [default: 512 for split-sum, 16 for anisotropic, 32 for glass, 64 otherwise].
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
 

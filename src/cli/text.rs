@@ -147,7 +147,7 @@ pub fn lut(s: &LutSummary) -> String {
             );
         }
         (None, Some(ior)) => {
-            let n = s.height;
+            let n = s.width / ior.len().max(1);
             let list: Vec<String> = ior.iter().map(|v| format!("{v:.3}")).collect();
             out += &format!(
                 "  {} slices of {n}×{n} side by side, slice k at IOR {}\n",
@@ -157,6 +157,13 @@ pub fn lut(s: &LutSummary) -> String {
             out += &format!(
                 "  in slice k, texel (x, y) at roughness (x − {n}k + ½)/{n}, N·V (y + ½)/{n}, first row first\n"
             );
+            if s.height == 2 * n {
+                out += &format!(
+                    "  two rows of slices: rows 0–{} light entering (η = IOR), rows {n}–{} leaving (η = 1/IOR, N·V (y − {n} + ½)/{n})\n",
+                    n - 1,
+                    2 * n - 1
+                );
+            }
         }
         (None, None) => {
             out += &format!(

@@ -27,15 +27,18 @@
 //! light sampling reaches; the sampler, and Cycles' own `ggx_glass_E` tables, do not.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 use super::albedo::gauss_unit;
-use super::fresnel;
 use super::microfacet::{Distribution, Masking, Microfacet, Roughness};
 use super::version::BlenderVersion;
+use super::{coat, fresnel};
+use crate::progress::Progress;
 
 /// Which node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(usize)]
 pub enum DielectricNode {
     /// Glass BSDF: reflection and refraction.
     Glass,
@@ -256,6 +259,102 @@ impl DielectricIntegrator {
             }
         }
         wr * reflected + wt * refracted
+    }
+}
+
+/// `E(μ, r, η)` of the Glass and Refraction nodes of one distribution and Blender version on
+/// a grid: μ and r on the given axes, η on the coat tables' index slices
+/// ([`coat::slice_iors`], 1 to [`coat::IOR_MAX`], even in `z = F0^¼`), entering (η = IOR)
+/// and leaving (η = 1/IOR). The one table builder for the LUT and the Blender groups.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DielectricGrid {
+    pub ior: [f64; coat::SLICES],
+    pub mu: Vec<f64>,
+    pub roughness: Vec<f64>,
+    /// `[node][side][k][i][j]` flattened: node 0 Glass, 1 Refraction; side 0 entering, 1
+    /// leaving.
+    values: Vec<f64>,
+}
+
+/// Which way the light crosses the interface of a [`DielectricGrid`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(usize)]
+pub enum Side {
+    /// From outside, η = IOR (a front face).
+    Entering,
+    /// From inside, η = 1/IOR (a back face).
+    Leaving,
+}
+
+impl Side {
+    pub const BOTH: [Side; 2] = [Side::Entering, Side::Leaving];
+
+    /// The relative index on this side of an interface of index `ior`.
+    pub fn eta(self, ior: f64) -> f64 {
+        match self {
+            Side::Entering => ior,
+            Side::Leaving => 1.0 / ior,
+        }
+    }
+}
+
+impl DielectricGrid {
+    /// `E(μ_i, r_j)` of `node` on `side` of slice k.
+    pub fn e(&self, node: DielectricNode, side: Side, k: usize, i: usize, j: usize) -> f64 {
+        let (n, m) = (self.mu.len(), self.roughness.len());
+        let node = node as usize;
+        let side = side as usize;
+        self.values[(((node * 2 + side) * coat::SLICES + k) * n + i) * m + j]
+    }
+}
+
+impl DielectricIntegrator {
+    /// The grid of `distribution` (GGX or Beckmann) as Blender `version` renders it, over
+    /// `mus` and `roughness`; rows of μ run in parallel and `progress` steps once per row.
+    pub fn grid(
+        &self,
+        distribution: Distribution,
+        version: BlenderVersion,
+        mus: &[f64],
+        roughness: &[Roughness],
+        progress: &dyn Progress,
+    ) -> DielectricGrid {
+        let ior = coat::slice_iors();
+        let (n, m) = (mus.len(), roughness.len());
+        let rows: Vec<Vec<f64>> = mus
+            .par_iter()
+            .map(|&mu| {
+                let mut row = vec![0.0; 2 * 2 * coat::SLICES * m];
+                for node in [DielectricNode::Glass, DielectricNode::Refraction] {
+                    for side in Side::BOTH {
+                        for (k, &n_k) in ior.iter().enumerate() {
+                            for (j, &r) in roughness.iter().enumerate() {
+                                let bsdf = Dielectric::new(node, distribution, r, version);
+                                let at = ((node as usize * 2 + side as usize) * coat::SLICES + k)
+                                    * m
+                                    + j;
+                                row[at] = self.directional_albedo(&bsdf, mu, side.eta(n_k));
+                            }
+                        }
+                    }
+                }
+                progress.step();
+                row
+            })
+            .collect();
+        let mut values = vec![0.0; 2 * 2 * coat::SLICES * n * m];
+        for (i, row) in rows.iter().enumerate() {
+            for (block, chunk) in row.chunks(m).enumerate() {
+                let start = (block * n + i) * m;
+                values[start..start + m].copy_from_slice(chunk);
+            }
+        }
+        DielectricGrid {
+            ior,
+            mu: mus.to_vec(),
+            roughness: roughness.iter().map(|r| r.get()).collect(),
+            values,
+        }
     }
 }
 

@@ -37,6 +37,10 @@
 //!   [`anisotropic`]): an atlas of 16 view azimuths side by side × n bitangent widths
 //!   stacked, each slice n × n over (tangent width, N·V) at grid points, not pixel centres:
 //!   **R = E(μ, φ, αx, αy)**, **G = E_avg(αx, αy)**. Quadrature, no samples.
+//! * [`Kind::Glass`], 2 channels, Cycles' Glass and Refraction BSDFs (see [`glass`]): 12
+//!   slices of n × n side by side over the index of refraction, light entering (η = IOR) in
+//!   the top row and leaving (η = 1/IOR) in the bottom one: **R = E(μ, r, η)** of the Glass
+//!   BSDF, **G = E(μ, r, η)** of the Refraction BSDF. Quadrature, no samples.
 //!
 //! # Formats
 //!
@@ -50,6 +54,7 @@
 pub mod anisotropic;
 pub mod coat;
 pub mod dds;
+pub mod glass;
 pub mod ktx2;
 pub mod kulla_conty;
 pub mod openexr;
@@ -84,6 +89,9 @@ pub enum Kind {
     /// Cycles' anisotropic lobe: slices over the view azimuth and the bitangent width
     /// (R = E(μ, φ, αx, αy), G = E_avg(αx, αy)).
     Anisotropic,
+    /// Cycles' Glass and Refraction BSDFs: slices over the index, entering and leaving
+    /// (R = E(μ, r, η) of Glass, G = of Refraction).
+    Glass,
 }
 
 impl Kind {
@@ -94,6 +102,7 @@ impl Kind {
             Kind::Albedo => "albedo",
             Kind::Coat => "coat",
             Kind::Anisotropic => "anisotropic",
+            Kind::Glass => "glass",
         }
     }
 }
@@ -303,6 +312,11 @@ pub enum Spec {
         distribution: Distribution,
         blender_version: BlenderVersion,
     },
+    Glass {
+        size: usize,
+        distribution: Distribution,
+        blender_version: BlenderVersion,
+    },
 }
 
 impl Spec {
@@ -369,6 +383,25 @@ impl Spec {
                     blender_version,
                 })
             }
+            Kind::Glass => {
+                reject_split_sum_flags(args)?;
+                reject_samples(args)?;
+                if distribution == Distribution::AshikhminShirley {
+                    return Err(Error::input(
+                        Field::Distribution,
+                        distribution.key(),
+                        Hint::new(
+                            "ggx or beckmann with {} glass (Blender's Glass and Refraction BSDFs have no Ashikhmin-Shirley)",
+                            [Field::Kind],
+                        ),
+                    ));
+                }
+                Ok(Spec::Glass {
+                    size,
+                    distribution,
+                    blender_version,
+                })
+            }
         }
     }
 
@@ -378,7 +411,8 @@ impl Spec {
             Spec::SplitSum { size, .. }
             | Spec::Albedo { size, .. }
             | Spec::Coat { size, .. }
-            | Spec::Anisotropic { size, .. } => size,
+            | Spec::Anisotropic { size, .. }
+            | Spec::Glass { size, .. } => size,
             Spec::KullaConty { size, .. } => 2 * size,
         }
     }
@@ -429,6 +463,11 @@ impl Spec {
                 blender_version.masking(),
                 progress,
             ),
+            Spec::Glass {
+                size,
+                distribution,
+                blender_version,
+            } => glass::glass_table(size, distribution, blender_version, progress),
         }
     }
 }
@@ -441,6 +480,7 @@ fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
         Kind::KullaConty => (64, 4096),
         Kind::Albedo | Kind::Coat => (64, 1),
         Kind::Anisotropic => (16, 1),
+        Kind::Glass => (32, 1),
     };
     let size = args.size.unwrap_or(default_size);
     let samples = args.samples.unwrap_or(default_samples);
@@ -466,6 +506,20 @@ fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
                 format!(
                     "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
                     coat::MAX_SIZE,
+                    crate::measure::coat::SLICES
+                ),
+                [Field::Kind],
+            ),
+        ));
+    }
+    if args.kind == Kind::Glass && size > glass::MAX_SIZE {
+        return Err(Error::input(
+            Field::Size,
+            size,
+            Hint::new(
+                format!(
+                    "texels per slice side from 1 to {} for {{}} glass (its atlas is {} slices wide and two high)",
+                    glass::MAX_SIZE,
                     crate::measure::coat::SLICES
                 ),
                 [Field::Kind],
@@ -669,7 +723,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         method: settings.method,
         distribution: settings.distribution,
         blender_version: settings.blender_version,
-        ior: matches!(spec, Spec::Coat { .. }).then(coat::ior),
+        ior: matches!(spec, Spec::Coat { .. } | Spec::Glass { .. }).then(coat::ior),
         azimuths: matches!(spec, Spec::Anisotropic { .. }).then(anisotropic::azimuths),
         bytes: bytes.len(),
         compute_seconds,
@@ -744,6 +798,11 @@ impl Settings {
                 distribution,
                 blender_version,
                 ..
+            }
+            | Spec::Glass {
+                distribution,
+                blender_version,
+                ..
             } => Settings::blender(distribution, blender_version),
         }
     }
@@ -776,6 +835,10 @@ impl Spec {
             Spec::Anisotropic { .. } => &[
                 "R: E(N·V, φ of the slice's column, αx = rx², αy = ry² of the slice's row)",
                 "G: E_avg(αx, αy)",
+            ],
+            Spec::Glass { .. } => &[
+                "R: E(μ, r, η) of the Glass BSDF, η = IOR of the slice (top row) or 1/IOR (bottom row)",
+                "G: E(μ, r, η) of the Refraction BSDF",
             ],
         }
     }
