@@ -463,7 +463,18 @@ fn cases() -> Vec<Case> {
             "EEVEE renders an anisotropic Glossy as an isotropic one",
         ])
         .writes_nothing_to(&["@/g.py"]),
+        case(&[
+            "generate", "--engine", "eevee", "--mode", "glass", "--script", "@/g.py",
+        ])
+        .says(&[
+            "invalid --mode 'glass'",
+            "Cycles' Glass and Refraction BSDFs",
+        ])
+        .writes_nothing_to(&["@/g.py"]),
         // --- verify -------------------------------------------------------------------
+        case(&["verify", "--mode", "glass"])
+            .no_blender()
+            .says(&["invalid --mode 'glass'", "tests/glass_e2e.rs"]),
         case(&["verify", "--anisotropy", "0.5"])
             .no_blender()
             .says(&[

@@ -105,9 +105,14 @@ fn previews_tell_groups_apart(label: &str, dir: &std::path::Path) {
         .collect();
     groups.sort();
     // Three distributions, each with its roughness, view and multiscatter group, and the
-    // anisotropic GGX and (from 3.5) Beckmann groups.
+    // anisotropic GGX and (from 3.5) Beckmann groups, and the Glass and Refraction groups of
+    // GGX and Beckmann.
     let anisotropic = if label == "3.4" { 1 } else { 2 };
-    assert_eq!(groups.len(), 9 + anisotropic, "Blender {label}: {groups:?}");
+    assert_eq!(
+        groups.len(),
+        9 + anisotropic + 4,
+        "Blender {label}: {groups:?}"
+    );
     let images: Vec<_> = groups.iter().map(|g| preview(dir, g)).collect();
     let height = images[0].height();
     // Nothing is cut off at the sides: the outer columns stay transparent.
@@ -183,7 +188,15 @@ fn generated_blend_works_in_every_blender() {
                 "--mode",
                 "view",
             ])
-            .args(["--mode", "multiscatter", "--mode", "anisotropic", "--blend"])
+            .args([
+                "--mode",
+                "multiscatter",
+                "--mode",
+                "anisotropic",
+                "--mode",
+                "glass",
+            ])
+            .arg("--blend")
             .arg(&blend)
             .arg("--script")
             .arg(&script)

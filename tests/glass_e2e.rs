@@ -158,3 +158,223 @@ fn blender_45_glass_renders_what_the_integrator_predicts() {
 fn blender_50_glass_renders_what_the_integrator_predicts() {
     check("5.0", "5.0", "3.4");
 }
+
+/// A furnace case of a solid sphere: its shader and where it must land.
+struct Solid {
+    group: Option<&'static str>,
+    node: DielectricNode,
+    distribution: &'static str,
+    roughness: f64,
+    ior: f64,
+}
+
+const fn solid(
+    group: Option<&'static str>,
+    node: DielectricNode,
+    distribution: &'static str,
+    roughness: f64,
+    ior: f64,
+) -> Solid {
+    Solid {
+        group,
+        node,
+        distribution,
+        roughness,
+        ior,
+    }
+}
+
+/// Renders solid spheres (every face the shader, 64 bounces) in Blender `label` with the
+/// groups of a `generate --mode glass` script built there: each case's (mean, darkest
+/// ring, brightest ring) over μ ≥ 0.22, or none when that Blender is skipped.
+fn solid_spheres(label: &str, cases: &[Solid], samples: u32) -> Option<Vec<(f64, f64, f64)>> {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("glass.py");
+    let out = common::gloffuse()
+        .args(["generate", "--mode", "glass", "--script"])
+        .arg(&script)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let node_key = |n: DielectricNode| match n {
+        DielectricNode::Glass => "glass",
+        DielectricNode::Refraction => "refraction",
+    };
+    let request = serde_json::json!({
+        "px": PX,
+        "samples": samples,
+        "script": script,
+        "cases": cases.iter().map(|c| serde_json::json!({
+            "node": node_key(c.node),
+            "distribution": c.distribution,
+            "roughness": c.roughness,
+            "ior": c.ior,
+            "solid": true,
+            "group": c.group,
+        })).collect::<Vec<_>>(),
+    });
+    let renders = render_cases(label, "glass_interface.py", &request, PX)?;
+    Some(
+        renders
+            .iter()
+            .map(|pixels| {
+                let mut rings = [(0.0, 0usize); RINGS];
+                for row in 0..PX {
+                    for col in 0..PX {
+                        if let Some(mu) = view_cosine(col, row) {
+                            let ring = &mut rings[((mu * RINGS as f64) as usize).min(RINGS - 1)];
+                            ring.0 += pixels[row * PX + col];
+                            ring.1 += 1;
+                        }
+                    }
+                }
+                let means: Vec<f64> = rings
+                    .iter()
+                    .filter(|r| r.1 > 0)
+                    .map(|r| r.0 / r.1 as f64)
+                    .collect();
+                let total: f64 = rings.iter().map(|r| r.0).sum();
+                let count: usize = rings.iter().map(|r| r.1).sum();
+                let lo = means.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = means.iter().copied().fold(0.0, f64::max);
+                (total / count as f64, lo, hi)
+            })
+            .collect(),
+    )
+}
+
+const GROUPS: [Solid; 8] = [
+    solid(
+        Some("Gloffuse Glass (GGX)"),
+        DielectricNode::Glass,
+        "GGX",
+        0.1,
+        1.5,
+    ),
+    solid(
+        Some("Gloffuse Glass (GGX)"),
+        DielectricNode::Glass,
+        "GGX",
+        0.5,
+        1.1,
+    ),
+    solid(
+        Some("Gloffuse Glass (GGX)"),
+        DielectricNode::Glass,
+        "GGX",
+        0.7,
+        1.5,
+    ),
+    solid(
+        Some("Gloffuse Glass (GGX)"),
+        DielectricNode::Glass,
+        "GGX",
+        1.0,
+        1.5,
+    ),
+    solid(
+        Some("Gloffuse Glass (GGX)"),
+        DielectricNode::Glass,
+        "GGX",
+        0.6,
+        2.4,
+    ),
+    solid(
+        Some("Gloffuse Glass (Beckmann)"),
+        DielectricNode::Glass,
+        "BECKMANN",
+        0.5,
+        1.33,
+    ),
+    solid(
+        Some("Gloffuse Glass (Beckmann)"),
+        DielectricNode::Glass,
+        "BECKMANN",
+        0.9,
+        1.8,
+    ),
+    solid(
+        Some("Gloffuse Refraction (GGX)"),
+        DielectricNode::Refraction,
+        "GGX",
+        0.5,
+        1.33,
+    ),
+];
+
+/// Blender's own glass beside them: single-scatter GGX and Multiscatter GGX at r 0.7,
+/// IOR 1.5.
+const BLENDERS_OWN: [Solid; 2] = [
+    solid(None, DielectricNode::Glass, "GGX", 0.7, 1.5),
+    solid(None, DielectricNode::Glass, "MULTI_GGX", 0.7, 1.5),
+];
+
+/// What a group's solid sphere must do in Blender `label`: (mean, every ring) within these
+/// of 100 %; none where it is shown but not judged. The goal is 2 % and 3 %; Blender 3.4
+/// misses it in two places (docs/RESULTS.md): its Beckmann sampler returns up to 1.3 %
+/// more than its lobes at each interface (2.3 % for the sphere at r 0.9, IOR 1.8), and at
+/// r 0.1 the refraction lobe of its two-closure glass falls from 1 to 0 within a few
+/// hundredths of μ at the critical angle inside the glass, which a table over μ blurs.
+fn solid_tolerance(label: &str, c: &Solid) -> Option<(f64, f64)> {
+    match (label, c.distribution) {
+        ("3.4", _) if c.roughness < 0.3 => None,
+        ("3.4", "BECKMANN") => Some((0.035, 0.035)),
+        _ => Some((0.02, 0.03)),
+    }
+}
+
+fn check_solid(label: &str) {
+    let cases: Vec<Solid> = GROUPS.into_iter().chain(BLENDERS_OWN).collect();
+    let Some(results) = solid_spheres(label, &cases, 512) else {
+        return;
+    };
+    let mut misses = Vec::new();
+    for (c, &(mean, lo, hi)) in cases.iter().zip(&results) {
+        let what = format!(
+            "Blender {label} {} {:?} {} r {} IOR {}: mean {:.2} %, rings {:.2}–{:.2} %",
+            c.group.unwrap_or("plain"),
+            c.node,
+            c.distribution,
+            c.roughness,
+            c.ior,
+            100.0 * mean,
+            100.0 * lo,
+            100.0 * hi
+        );
+        println!("{what}");
+        let judged = match (c.group, c.distribution) {
+            (Some(_), _) => solid_tolerance(label, c).is_none_or(|(m, r)| {
+                (mean - 1.0).abs() <= m && (lo - 1.0).abs() <= r && (hi - 1.0).abs() <= r
+            }),
+            // Blender's single-scatter glass loses a third of the light.
+            (None, "GGX") => mean < 0.7,
+            // Multiscatter GGX glass: 3.4's random walk keeps everything; 4.5's and
+            // 5.0's tables leave the rim a few per cent dark.
+            (None, _) if label == "3.4" => (mean - 1.0).abs() < 0.005,
+            (None, _) => mean < 0.99 && lo < 0.97,
+        };
+        if !judged {
+            misses.push(what);
+        }
+    }
+    assert!(misses.is_empty(), "{}", misses.join("\n"));
+}
+
+#[test]
+fn blender_34_solid_glass() {
+    check_solid("3.4");
+}
+
+#[test]
+fn blender_45_solid_glass() {
+    check_solid("4.5");
+}
+
+#[test]
+fn blender_50_solid_glass() {
+    check_solid("5.0");
+}

@@ -29,6 +29,11 @@ def masking_family(height_correlated_from):
     return "height-correlated" if tuple(bpy.app.version[:2]) >= first else "separable"
 
 
+def blender_at_least(version):
+    """Whether this Blender is `version` ([major, minor]) or later."""
+    return tuple(bpy.app.version[:2]) >= tuple(int(part) for part in version)
+
+
 def valid_reflection_rule():
     """How Cycles raises a shading normal whose mirror reflection would dip
     below the surface (docs/PHYSICS.md §7): "3.0" (every BSDF, two candidate

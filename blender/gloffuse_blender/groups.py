@@ -12,6 +12,7 @@
 import bpy
 
 from .anisotropic_groups import build_anisotropic_group
+from .glass_groups import build_glass_group
 from .layered_groups import build_layered_group
 from .nodes import GLOFFUSE_TAG, is_tagged
 from .normal_group import build_normal_group
@@ -27,11 +28,14 @@ def group_names(params):
         view = spec.get("view") or {}
         layered = spec.get("layered") or {}
         anisotropic = spec.get("anisotropic") or {}
-        for name in (spec.get("normal_group") if view or layered or anisotropic else None,
+        glass = spec.get("glass") or {}
+        for name in (spec.get("normal_group") if view or layered or anisotropic or glass
+                     else None,
                      spec["correction_group"], spec["shader_group"],
                      view.get("correction_group"), view.get("shader_group"),
                      view.get("multiscatter_group"), layered.get("shader_group"),
-                     anisotropic.get("shader_group")):
+                     anisotropic.get("shader_group"), glass.get("glass_group"),
+                     glass.get("refraction_group")):
             if name is not None and name not in names:
                 names.append(name)
     return names
@@ -42,7 +46,8 @@ def build_all(params, on_spec=None):
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
     with spec["layered"] the layered group, with spec["anisotropic"] the
-    anisotropic group, after the normal group they use
+    anisotropic group, with spec["glass"] the glass and refraction groups,
+    after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
     with the first spec that uses it. on_spec(spec), if given, is told before
@@ -71,6 +76,9 @@ def build_all(params, on_spec=None):
             trees.append(build_layered_group(spec, params))
         if spec.get("anisotropic"):
             trees.append(build_anisotropic_group(spec, params))
+        if spec.get("glass"):
+            trees.append(build_glass_group(spec, params, "glass"))
+            trees.append(build_glass_group(spec, params, "refraction"))
         built.append((spec, trees))
     names = group_names(params)
     for _spec, trees in built:

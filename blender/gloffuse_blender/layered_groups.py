@@ -82,18 +82,18 @@ def layered_sockets(spec):
     ]
 
 
-def coat_image(layered, key, name):
-    """The packed float image `name` of the coat table's `key` ("values": A;
-    "gain": A / E_F) over (mu, r, IOR), slice by slice side by side: slice k
-    packed by cell (see corner_cells in view_groups.py) fills columns
-    k (size - 1) .. (k + 1) (size - 1) - 1, row i the cells between
-    mu = i / (size - 1) and (i + 1) / (size - 1)."""
-    table = layered["coat_table"]
+def slice_image(table, key, name, where):
+    """The packed float image `name` of an index-sliced table's `key` (the coat
+    table's "values": A, "gain": A / E_F; the glass table's four E) over
+    (mu, r, IOR), slice by slice side by side: slice k packed by cell (see
+    corner_cells in view_groups.py) fills columns k (size - 1) ..
+    (k + 1) (size - 1) - 1, row i the cells between mu = i / (size - 1) and
+    (i + 1) / (size - 1). `where` names the table in errors."""
     size, slices = int(table["size"]), int(table["slices"])
-    values = finite_list(table[key], "layered.coat_table." + key)
+    values = finite_list(table[key], "%s.%s" % (where, key))
     if len(values) != size * slices * size:
-        raise ValueError("layered.coat_table.%s holds %d values, not %d x %d"
-                         % (key, len(values), size * slices, size))
+        raise ValueError("%s.%s holds %d values, not %d x %d"
+                         % (where, key, len(values), size * slices, size))
     cells = size - 1
     packed = [corner_cells(lambda i, j, k=k: values[(i * slices + k) * size + j], size, size)
               for k in range(slices)]
@@ -104,19 +104,18 @@ def coat_image(layered, key, name):
     return packed_float_image(name, cells * slices, cells, pixels)
 
 
-def clamped_ior(layered, chain, ior):
-    """n = IOR clamped to the coat table's range."""
-    ior_max = float(layered["coat_table"]["ior_max"])
+def clamped_ior(table, chain, ior):
+    """n = IOR clamped to an index-sliced table's range."""
+    ior_max = float(table["ior_max"])
     return chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, ior_max), ior,
                        LAYERED_IOR_MIN, ior_max)
 
 
-def coat_cell(layered, chain, roughness, mu, n):
-    """Nodes that find where (mu, r, n) falls in the coat tables: returns
+def slice_cell(table, chain, roughness, mu, n):
+    """Nodes that find where (mu, r, n) falls in an index-sliced table: returns
     ((column in slice k, column in slice k + 1, row, across, up, t), rho), t
     the fraction of the way from slice k to k + 1 in z = F0^(1/4), and
     rho = (n - 1) / (n + 1) = sqrt(F0)."""
-    table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4).
@@ -134,8 +133,8 @@ def coat_cell(layered, chain, roughness, mu, n):
     return (first, second, row, across, up, t), rho
 
 
-def coat_read(chain, image, cell, what):
-    """Nodes that read the coat table `image` at `cell` (coat_cell): each
+def slice_read(chain, image, cell, what):
+    """Nodes that read an index-sliced table `image` at `cell` (slice_cell): each
     slice bilinear in (r, mu), the two mixed linearly. Returns the socket."""
     first, second, row, across, up, t = cell
     v = [bilinear(chain, read_cell(chain, image, c, row, "%s(mu, r) slice %s" % (what, name)),
@@ -168,7 +167,7 @@ def principled_coat(tree, group_in, n, x):
 def tinted_ior(chain, rho, tint):
     """Per channel, the index whose F0 is F0(n) x Specular Tint (Principled's
     tint of F0; grazing reflection stays white): (1 + s) / (1 - s) with
-    s = rho x sqrt(tint), rho = (n - 1) / (n + 1) (coat_cell), the tint taken
+    s = rho x sqrt(tint), rho = (n - 1) / (n + 1) (slice_cell), the tint taken
     at least 0 (as Principled does) and s below 1. Vector Math's POWER exists
     where this coat is built (5.0+)."""
     root = chain.vector("POWER", "sqrt(tint)",
@@ -195,8 +194,9 @@ def metallic_coat(tree, chain, group_in, layered, cell, rho, distribution):
     first = metallic_coat_node(tree.nodes, distribution)
     if first is None:
         return None
-    gain_image = coat_image(layered, "gain", layered["coat_gain_image"])
-    gain = coat_read(chain, gain_image, cell, "G")
+    gain_image = slice_image(layered["coat_table"], "gain", layered["coat_gain_image"],
+                             "layered.coat_table")
+    gain = slice_read(chain, gain_image, cell, "G")
     extra = chain.math("SUBTRACT", "gain - 1 = A / E_F - 1", gain, 1.0, name="Coat extra")
     ior = tinted_ior(chain, rho, group_in.outputs["Specular Tint"])
     second = metallic_coat_node(tree.nodes, distribution)
@@ -235,9 +235,12 @@ def build_layered_group(spec, params):
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, spec, group_in, 1, frame)
     chain = Chain(tree, frame, column=2, y=0.0)
-    n = clamped_ior(layered, chain, group_in.outputs["IOR"])
-    cell, rho = coat_cell(layered, chain, r, mu, n)
-    a = coat_read(chain, coat_image(layered, "values", layered["coat_image"]), cell, "A")
+    coat_table = layered["coat_table"]
+    n = clamped_ior(coat_table, chain, group_in.outputs["IOR"])
+    cell, rho = slice_cell(coat_table, chain, r, mu, n)
+    a = slice_read(chain, slice_image(coat_table, "values", layered["coat_image"],
+                                      "layered.coat_table"),
+                   cell, "A")
     base = chain.math("SUBTRACT", "1 - A", 1.0, a, name="Base weight")
     base_color = chain.vector("SCALE", "Base Color × (1 - A)", group_in.outputs["Base Color"],
                               base, name="Base colour")

@@ -14,7 +14,7 @@
 import json
 import math
 
-from .compat import masking_family, max_name_bytes
+from .compat import blender_at_least, masking_family, max_name_bytes
 
 DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
 CURVE_VARIABLES = ("roughness", "alpha")
@@ -108,10 +108,30 @@ def resolve_params(document):
                 "image": family.get("anisotropic_image"),
                 "table": family.get("anisotropic_table"),
             }
+        # The glass groups are built where this Blender renders the glass of its family's
+        # table (not 3.5, whose glass is still 3.0-3.4's).
+        glass_table = family.get("glass_table")
+        if spec.get("glass_group") is not None and isinstance(glass_table, dict) \
+                and _version_pair(glass_table.get("from_version"), where) \
+                and blender_at_least(glass_table["from_version"]):
+            group["glass"] = {
+                "glass_group": spec["glass_group"],
+                "refraction_group": spec.get("refraction_group"),
+                "image": family.get("glass_image"),
+                "table": glass_table,
+            }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
     params["groups"] = resolved
     return validate_params(params)
+
+
+def _version_pair(value, where):
+    """True for [major, minor]; ValueError otherwise."""
+    if isinstance(value, list) and len(value) == 2 \
+            and all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+        return True
+    raise ValueError("%s: glass_table.from_version must be [major, minor], got %r" % (where, value))
 
 
 def validate_params(params):
@@ -141,7 +161,7 @@ def validate_params(params):
                              % (where, spec.get("engine"), ", ".join(ENGINES)))
         view = spec.get("view")
         if (view is not None or spec.get("layered") is not None
-                or spec.get("anisotropic") is not None) \
+                or spec.get("anisotropic") is not None or spec.get("glass") is not None) \
                 and spec.get("normal_group") not in normals:
             # One normal group serves every spec of an engine.
             _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
@@ -188,6 +208,19 @@ def validate_params(params):
                     isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "azimuths")):
                 raise ValueError("%s.anisotropic.table needs integer size and azimuths of at "
                                  "least 2" % where)
+        glass = spec.get("glass")
+        if glass is not None:
+            if not isinstance(glass, dict):
+                raise ValueError("%s.glass must be an object" % where)
+            for key in ("glass_group", "refraction_group"):
+                _name(glass.get(key), "%s.glass.%s" % (where, key), limit, seen)
+            _name(glass.get("image"), "%s.glass.image" % where, limit)
+            table = glass.get("table")
+            if not isinstance(table, dict) or not all(
+                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "slices")):
+                raise ValueError("%s.glass.table needs integer size and slices of at least 2" % where)
+            if finite_list([table.get("ior_max")], "%s.glass.table.ior_max" % where)[0] <= 1.0:
+                raise ValueError("%s.glass.table.ior_max must be above 1" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))

@@ -38,6 +38,8 @@ PREVIEW_COLORS = {
     "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
     "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
     "anisotropic": (0.72, 0.78, 0.9, 1.0),  # brushed steel
+    "glass": (0.85, 0.95, 0.9, 1.0),  # a faint green, as window glass
+    "refraction": (0.85, 0.95, 0.9, 1.0),
 }
 # The anisotropic group's preview stretches its highlight along the default tangent.
 PREVIEW_ANISOTROPY = 0.8
@@ -178,11 +180,14 @@ def preview_groups(spec):
     view = spec.get("view") or {}
     layered = spec.get("layered") or {}
     anisotropic = spec.get("anisotropic") or {}
+    glass = spec.get("glass") or {}
     groups = [(spec["shader_group"], "roughness", [spec["correction_group"]]),
               (view.get("shader_group"), "view", [view.get("correction_group")]),
               (view.get("multiscatter_group"), "multiscatter", []),
               (layered.get("shader_group"), "layered", []),
-              (anisotropic.get("shader_group"), "anisotropic", [])]
+              (anisotropic.get("shader_group"), "anisotropic", []),
+              (glass.get("glass_group"), "glass", []),
+              (glass.get("refraction_group"), "refraction", [])]
     return [(name, kind, helpers) for name, kind, helpers in groups if name]
 
 
@@ -222,7 +227,8 @@ def render_previews(built, directory, on_preview=None):
             layered = spec.get("layered") or {}
             first_view = (view.get("shader_group") or view.get("multiscatter_group")
                           or layered.get("shader_group")
-                          or (spec.get("anisotropic") or {}).get("shader_group"))
+                          or (spec.get("anisotropic") or {}).get("shader_group")
+                          or (spec.get("glass") or {}).get("glass_group"))
             if normal_name is not None and first_view in shown:
                 first_user.setdefault(normal_name, shown[first_view])
         # A normal group is built with the first spec that uses it, but that spec may

@@ -209,6 +209,10 @@ const MODES: &[Choice<Mode>] = &[
         Mode::Anisotropic,
         "an anisotropic Glossy (GGX; Cycles) with gain 1/E(μ, φ, αx, αy), φ the view's azimuth from the tangent: every pixel 100 %",
     ),
+    choice(
+        Mode::Glass,
+        "Glass and Refraction BSDFs (GGX, Beckmann; Cycles) with gain 1/E(μ, r, η), η = IOR on front faces and 1/IOR on back faces: every interface returns all the light meeting it",
+    ),
 ];
 
 const ENGINES: &[Choice<Engine>] = &[

@@ -158,11 +158,7 @@ pub fn lut(s: &LutSummary) -> String {
                 "  in slice k, texel (x, y) at roughness (x − {n}k + ½)/{n}, N·V (y + ½)/{n}, first row first\n"
             );
             if s.height == 2 * n {
-                out += &format!(
-                    "  two rows of slices: rows 0–{} light entering (η = IOR), rows {n}–{} leaving (η = 1/IOR, N·V (y − {n} + ½)/{n})\n",
-                    n - 1,
-                    2 * n - 1
-                );
+                out += &glass_rows(n);
             }
         }
         (None, None) => {
@@ -439,5 +435,14 @@ pub fn bench_shards(r: &gloffuse::bench::shards::ShardBenchResult) -> String {
         r.speedup,
         r.start_seconds,
         r.per_material_seconds
+    )
+}
+
+/// The glass atlas's two rows of slices, entering and leaving.
+fn glass_rows(n: usize) -> String {
+    format!(
+        "  two rows of slices: rows 0–{} light entering (η = IOR), rows {n}–{} leaving (η = 1/IOR, N·V (y − {n} + ½)/{n})\n",
+        n - 1,
+        2 * n - 1
     )
 }

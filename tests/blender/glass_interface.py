@@ -1,16 +1,23 @@
 # ---------------------------------------------------------------------------
-# glass_interface.py: renders one rough dielectric interface at a time with
-# Blender's own Glass or Refraction BSDF, for tests/glass_e2e.rs to compare
-# with the integrator's E(mu, r, eta) ring by ring.
+# glass_interface.py: renders rough dielectric spheres with Blender's own
+# Glass or Refraction BSDF or a gloffuse glass group, for tests/glass_e2e.rs:
+# one interface at a time (to compare with the integrator's E(mu, r, eta)
+# ring by ring) or a solid sphere in the furnace.
 #
 #     glass_interface.py CASES.json OUT.json
 #
-# CASES.json: {"px": N, "samples": S, "cases": [{"node": "glass" |
-# "refraction", "distribution": "GGX" | "BECKMANN", "roughness": r, "ior": n,
-# "inside": bool}, ...]}. A unit sphere (smooth UV sphere) at the origin, an
-# orthographic camera on -Y looking along +Y with ortho scale 2 (pixel
-# (col, row) sees x = (col + 1/2)/N * 2 - 1, z likewise, bottom row first), a
-# white world of strength 1 and a point-like pixel filter. The first surface
+# CASES.json: {"px": N, "samples": S, "script": optional gloffuse generate
+# script, run first to build its groups in this Blender, "cases": [{"node":
+# "glass" | "refraction", "distribution": "GGX" | "BECKMANN" | "MULTI_GGX",
+# "roughness": r, "ior": n, "inside": bool, "solid": bool, "group": optional
+# name}, ...]}. A case with a "group" is shaded with that node group (white
+# Color, the case's Roughness and IOR); one without, with Blender's own node.
+# Every case: a unit sphere (smooth UV sphere) at the origin, an orthographic
+# camera on -Y looking along +Y with ortho scale 2 (pixel (col, row) sees
+# x = (col + 1/2)/N * 2 - 1, z likewise, bottom row first), a white world of
+# strength 1, a point-like pixel filter and up to 64 bounces of every kind (a
+# solid glass sphere keeps light inside for many). A "solid" case is that
+# shader on every face. Otherwise the first surface
 # a camera ray meets is the white BSDF; the second is a white Emission of
 # strength 1 that scatters nothing and is not sampled as a light. So a pixel
 # is what the interface returns of what reaches it: reflected light from the
@@ -27,7 +34,24 @@ import tempfile
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from anisotropic_sphere import build_groups  # noqa: E402 (after the path it needs)
+
 NODES = {"glass": "ShaderNodeBsdfGlass", "refraction": "ShaderNodeBsdfRefraction"}
+
+
+def shader_node(nodes, case):
+    """The case's BSDF node or group node, white, at its roughness and index."""
+    if case.get("group"):
+        node = nodes.new("ShaderNodeGroup")
+        node.node_tree = bpy.data.node_groups[case["group"]]
+    else:
+        node = nodes.new(NODES[case["node"]])
+        node.distribution = case["distribution"]
+    node.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    node.inputs["Roughness"].default_value = case["roughness"]
+    node.inputs["IOR"].default_value = case["ior"]
+    return node
 
 
 def interface_material(case):
@@ -40,11 +64,10 @@ def interface_material(case):
     nodes, links = material.node_tree.nodes, material.node_tree.links
     nodes.clear()
     output = nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nodes.new(NODES[case["node"]])
-    bsdf.distribution = case["distribution"]
-    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    bsdf.inputs["Roughness"].default_value = case["roughness"]
-    bsdf.inputs["IOR"].default_value = case["ior"]
+    bsdf = shader_node(nodes, case)
+    if case.get("solid"):
+        links.new(bsdf.outputs[0], output.inputs["Surface"])
+        return material
     emission = nodes.new("ShaderNodeEmission")
     emission.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     emission.inputs["Strength"].default_value = 1.0
@@ -89,6 +112,8 @@ def build_scene(px, samples):
     cycles.blur_glossy = 0.0
     cycles.sample_clamp_direct = 0.0
     cycles.sample_clamp_indirect = 0.0
+    for kind in ("max", "diffuse", "glossy", "transmission", "transparent_max"):
+        setattr(cycles, kind + "_bounces", 64)
     scene.render.resolution_x = scene.render.resolution_y = px
     scene.render.resolution_percentage = 100
     scene.view_settings.view_transform = "Standard"
@@ -109,6 +134,8 @@ def main(argv):
         request = json.load(handle)
     px = int(request["px"])
     scene, sphere = build_scene(px, int(request["samples"]))
+    if request.get("script"):
+        build_groups(request["script"])
     renders = []
     with tempfile.TemporaryDirectory() as folder:
         for index, case in enumerate(request["cases"]):

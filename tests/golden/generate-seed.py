@@ -34,6 +34,11 @@ def masking_family(height_correlated_from):
     return "height-correlated" if tuple(bpy.app.version[:2]) >= first else "separable"
 
 
+def blender_at_least(version):
+    """Whether this Blender is `version` ([major, minor]) or later."""
+    return tuple(bpy.app.version[:2]) >= tuple(int(part) for part in version)
+
+
 def valid_reflection_rule():
     """How Cycles raises a shading normal whose mirror reflection would dip
     below the surface (docs/PHYSICS.md §7): "3.0" (every BSDF, two candidate
@@ -1171,10 +1176,30 @@ def resolve_params(document):
                 "image": family.get("anisotropic_image"),
                 "table": family.get("anisotropic_table"),
             }
+        # The glass groups are built where this Blender renders the glass of its family's
+        # table (not 3.5, whose glass is still 3.0-3.4's).
+        glass_table = family.get("glass_table")
+        if spec.get("glass_group") is not None and isinstance(glass_table, dict) \
+                and _version_pair(glass_table.get("from_version"), where) \
+                and blender_at_least(glass_table["from_version"]):
+            group["glass"] = {
+                "glass_group": spec["glass_group"],
+                "refraction_group": spec.get("refraction_group"),
+                "image": family.get("glass_image"),
+                "table": glass_table,
+            }
         resolved.append(group)
     params = {key: value for key, value in document.items() if key != "groups"}
     params["groups"] = resolved
     return validate_params(params)
+
+
+def _version_pair(value, where):
+    """True for [major, minor]; ValueError otherwise."""
+    if isinstance(value, list) and len(value) == 2 \
+            and all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+        return True
+    raise ValueError("%s: glass_table.from_version must be [major, minor], got %r" % (where, value))
 
 
 def validate_params(params):
@@ -1204,7 +1229,7 @@ def validate_params(params):
                              % (where, spec.get("engine"), ", ".join(ENGINES)))
         view = spec.get("view")
         if (view is not None or spec.get("layered") is not None
-                or spec.get("anisotropic") is not None) \
+                or spec.get("anisotropic") is not None or spec.get("glass") is not None) \
                 and spec.get("normal_group") not in normals:
             # One normal group serves every spec of an engine.
             _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
@@ -1251,6 +1276,19 @@ def validate_params(params):
                     isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "azimuths")):
                 raise ValueError("%s.anisotropic.table needs integer size and azimuths of at "
                                  "least 2" % where)
+        glass = spec.get("glass")
+        if glass is not None:
+            if not isinstance(glass, dict):
+                raise ValueError("%s.glass must be an object" % where)
+            for key in ("glass_group", "refraction_group"):
+                _name(glass.get(key), "%s.glass.%s" % (where, key), limit, seen)
+            _name(glass.get("image"), "%s.glass.image" % where, limit)
+            table = glass.get("table")
+            if not isinstance(table, dict) or not all(
+                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "slices")):
+                raise ValueError("%s.glass.table needs integer size and slices of at least 2" % where)
+            if finite_list([table.get("ior_max")], "%s.glass.table.ior_max" % where)[0] <= 1.0:
+                raise ValueError("%s.glass.table.ior_max must be above 1" % where)
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))
@@ -2138,18 +2176,18 @@ def layered_sockets(spec):
     ]
 
 
-def coat_image(layered, key, name):
-    """The packed float image `name` of the coat table's `key` ("values": A;
-    "gain": A / E_F) over (mu, r, IOR), slice by slice side by side: slice k
-    packed by cell (see corner_cells in view_groups.py) fills columns
-    k (size - 1) .. (k + 1) (size - 1) - 1, row i the cells between
-    mu = i / (size - 1) and (i + 1) / (size - 1)."""
-    table = layered["coat_table"]
+def slice_image(table, key, name, where):
+    """The packed float image `name` of an index-sliced table's `key` (the coat
+    table's "values": A, "gain": A / E_F; the glass table's four E) over
+    (mu, r, IOR), slice by slice side by side: slice k packed by cell (see
+    corner_cells in view_groups.py) fills columns k (size - 1) ..
+    (k + 1) (size - 1) - 1, row i the cells between mu = i / (size - 1) and
+    (i + 1) / (size - 1). `where` names the table in errors."""
     size, slices = int(table["size"]), int(table["slices"])
-    values = finite_list(table[key], "layered.coat_table." + key)
+    values = finite_list(table[key], "%s.%s" % (where, key))
     if len(values) != size * slices * size:
-        raise ValueError("layered.coat_table.%s holds %d values, not %d x %d"
-                         % (key, len(values), size * slices, size))
+        raise ValueError("%s.%s holds %d values, not %d x %d"
+                         % (where, key, len(values), size * slices, size))
     cells = size - 1
     packed = [corner_cells(lambda i, j, k=k: values[(i * slices + k) * size + j], size, size)
               for k in range(slices)]
@@ -2160,19 +2198,18 @@ def coat_image(layered, key, name):
     return packed_float_image(name, cells * slices, cells, pixels)
 
 
-def clamped_ior(layered, chain, ior):
-    """n = IOR clamped to the coat table's range."""
-    ior_max = float(layered["coat_table"]["ior_max"])
+def clamped_ior(table, chain, ior):
+    """n = IOR clamped to an index-sliced table's range."""
+    ior_max = float(table["ior_max"])
     return chain.clamp("n = clamp(IOR, %g, %g)" % (LAYERED_IOR_MIN, ior_max), ior,
                        LAYERED_IOR_MIN, ior_max)
 
 
-def coat_cell(layered, chain, roughness, mu, n):
-    """Nodes that find where (mu, r, n) falls in the coat tables: returns
+def slice_cell(table, chain, roughness, mu, n):
+    """Nodes that find where (mu, r, n) falls in an index-sliced table: returns
     ((column in slice k, column in slice k + 1, row, across, up, t), rho), t
     the fraction of the way from slice k to k + 1 in z = F0^(1/4), and
     rho = (n - 1) / (n + 1) = sqrt(F0)."""
-    table = layered["coat_table"]
     size, slices = int(table["size"]), int(table["slices"])
     z_max = float(table["z_max"])
     # z = sqrt(|(n - 1) / (n + 1)|) = F0^(1/4).
@@ -2190,8 +2227,8 @@ def coat_cell(layered, chain, roughness, mu, n):
     return (first, second, row, across, up, t), rho
 
 
-def coat_read(chain, image, cell, what):
-    """Nodes that read the coat table `image` at `cell` (coat_cell): each
+def slice_read(chain, image, cell, what):
+    """Nodes that read an index-sliced table `image` at `cell` (slice_cell): each
     slice bilinear in (r, mu), the two mixed linearly. Returns the socket."""
     first, second, row, across, up, t = cell
     v = [bilinear(chain, read_cell(chain, image, c, row, "%s(mu, r) slice %s" % (what, name)),
@@ -2224,7 +2261,7 @@ def principled_coat(tree, group_in, n, x):
 def tinted_ior(chain, rho, tint):
     """Per channel, the index whose F0 is F0(n) x Specular Tint (Principled's
     tint of F0; grazing reflection stays white): (1 + s) / (1 - s) with
-    s = rho x sqrt(tint), rho = (n - 1) / (n + 1) (coat_cell), the tint taken
+    s = rho x sqrt(tint), rho = (n - 1) / (n + 1) (slice_cell), the tint taken
     at least 0 (as Principled does) and s below 1. Vector Math's POWER exists
     where this coat is built (5.0+)."""
     root = chain.vector("POWER", "sqrt(tint)",
@@ -2251,8 +2288,9 @@ def metallic_coat(tree, chain, group_in, layered, cell, rho, distribution):
     first = metallic_coat_node(tree.nodes, distribution)
     if first is None:
         return None
-    gain_image = coat_image(layered, "gain", layered["coat_gain_image"])
-    gain = coat_read(chain, gain_image, cell, "G")
+    gain_image = slice_image(layered["coat_table"], "gain", layered["coat_gain_image"],
+                             "layered.coat_table")
+    gain = slice_read(chain, gain_image, cell, "G")
     extra = chain.math("SUBTRACT", "gain - 1 = A / E_F - 1", gain, 1.0, name="Coat extra")
     ior = tinted_ior(chain, rho, group_in.outputs["Specular Tint"])
     second = metallic_coat_node(tree.nodes, distribution)
@@ -2291,9 +2329,12 @@ def build_layered_group(spec, params):
     r = clamped_roughness(tree, group_in, frame)
     mu = view_cosine(tree, spec, group_in, 1, frame)
     chain = Chain(tree, frame, column=2, y=0.0)
-    n = clamped_ior(layered, chain, group_in.outputs["IOR"])
-    cell, rho = coat_cell(layered, chain, r, mu, n)
-    a = coat_read(chain, coat_image(layered, "values", layered["coat_image"]), cell, "A")
+    coat_table = layered["coat_table"]
+    n = clamped_ior(coat_table, chain, group_in.outputs["IOR"])
+    cell, rho = slice_cell(coat_table, chain, r, mu, n)
+    a = slice_read(chain, slice_image(coat_table, "values", layered["coat_image"],
+                                      "layered.coat_table"),
+                   cell, "A")
     base = chain.math("SUBTRACT", "1 - A", 1.0, a, name="Base weight")
     base_color = chain.vector("SCALE", "Base Color × (1 - A)", group_in.outputs["Base Color"],
                               base, name="Base colour")
@@ -2347,6 +2388,152 @@ COAT_DESCRIPTIONS = {
               "GGX)",
 }
 
+# ======== gloffuse part: glass_groups.py ========
+# ---------------------------------------------------------------------------
+# gloffuse glass_groups.py: "Gloffuse Glass (...)" and "Gloffuse Refraction
+# (...)", Blender's own Glass and Refraction BSDFs whose colour is divided by
+# E(mu, r, eta), the albedo of one rough dielectric interface (spec["glass"]).
+#
+# A rough interface returns less light than meets it: the part its single
+# microfacet bounce misses. E is that part's complement, computed by gloffuse
+# for exactly the BSDF this Blender renders (3.0-3.4: two closures weighted
+# by the Fresnel at the normal; 3.6 on: one closure with the Fresnel of each
+# microfacet). eta is the index beyond the surface over the index before it:
+# IOR on a front face (light entering), 1 / IOR on a back face (light leaving,
+# where Cycles shades the inside of the glass). With colour Color / E every
+# interface returns Color of what meets it, entering and leaving, so a white
+# solid glass object in an evenly lit white world is 100 % bright.
+#
+# E travels as packed float images laid out as the layered groups' coat
+# table (layered_groups.py's slice_image), entering and leaving; the group
+# reads both sides at (mu, r, IOR) and takes the one its face needs (Geometry
+# > Backfacing). In 3.0-3.5 the Glass node's E is F R + max(1e-4, 1 - F) T
+# with the Fresnel F at the normal (a Fresnel node, exact where it jumps at
+# the critical angle) and the lobes' R and T from the tables. mu comes from
+# the shading-normal group (normal_group.py).
+#
+# A module of the gloffuse_blender package. Functions and constants only.
+# ---------------------------------------------------------------------------
+
+# Which Blender node each group wraps, and what it is.
+GLASS_NODES = {
+    "glass": ("ShaderNodeBsdfGlass", "Glass BSDF", "reflection and refraction"),
+    "refraction": ("ShaderNodeBsdfRefraction", "Refraction BSDF", "refraction only"),
+}
+GLASS_IOR_MIN = 1.0
+
+
+def glass_sockets(glass):
+    """Color, Roughness, IOR, Normal [, Bump Map Correction] -> BSDF."""
+    return [
+        {"in_out": "INPUT", "name": "Color", "type": "NodeSocketColor",
+         "default": (1.0, 1.0, 1.0, 1.0), "description": "Colour of the glass"},
+        {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
+         "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness (0..1)"},
+        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
+         "default": 1.5, "min": GLASS_IOR_MIN, "max": float(glass["table"]["ior_max"]),
+         "description": "Index of refraction of the glass (the back faces are its inside)"},
+        NORMAL_INPUT,
+    ] + bump_map_correction_inputs(glass["spec"]) + [
+        {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
+         "description": "Rough dielectric that returns all the light meeting it, both ways"},
+    ]
+
+
+def glass_image(glass, node, side):
+    """The packed float image of E for `node` ("glass" or "refraction") and
+    `side` ("entering" or "leaving")."""
+    key = "%s_%s" % (node, side)
+    return slice_image(glass["table"], key, "%s %s %s" % (glass["image"], node, side),
+                       "glass.table")
+
+
+def two_closure_albedo(tree, chain, glass, group_in, cell, n, refracted, frame):
+    """Blender 3.0-3.5's Glass is two closures weighted by the Fresnel at the
+    normal F: E = F R + max(1e-4, 1 - F) T, R the reflection lobe's albedo
+    (read from the table), T the refraction lobe's (`refracted`). F comes from
+    a Fresnel node, which takes 1 / IOR on a back face as the closures do; in
+    a table over mu it would blur where it jumps to 1 at the critical angle."""
+    reflection = slice_image(glass["table"], "reflection", "%s reflection" % glass["image"],
+                             "glass.table")
+    reflected = slice_read(chain, reflection, cell, "R")
+    fresnel = tree.nodes.new("ShaderNodeFresnel")
+    fresnel.name = "Fresnel at the normal"
+    set_parent(fresnel, frame)
+    fresnel.location = (FRAME_INSET, -3 * ROW_STEP)
+    tree.links.new(n, fresnel.inputs["IOR"])
+    tree.links.new(group_in.outputs["Normal"], fresnel.inputs["Normal"])
+    f = fresnel.outputs["Fac"]
+    weight = chain.math("MAXIMUM", "max(1e-4, 1 - F)", chain.math("SUBTRACT", "1 - F", 1.0, f),
+                        1e-4)
+    return chain.math("MULTIPLY_ADD", "E = F R + max(1e-4, 1 - F) T", f, reflected,
+                      chain.math("MULTIPLY", "max(1e-4, 1 - F) T", weight, refracted))
+
+
+def build_glass_group(spec, params, node):
+    """Color, Roughness, IOR, Normal -> BSDF: Blender's `node` ("glass" or
+    "refraction") of colour Color / E(mu, r, eta)."""
+    glass = spec["glass"]
+    kind, label, what = GLASS_NODES[node]
+    tree = reuse_or_create_group(glass["%s_group" % node])
+    ensure_interface(tree, glass_sockets(dict(glass, spec=spec)))
+    nodes, links = tree.nodes, tree.links
+    group_in = nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+    frame = new_frame(tree, "Albedo frame",
+                      "Gain = 1 / E(mu, r, eta): eta = IOR on a front face, 1 / IOR on a back face")
+    r = clamped_roughness(tree, group_in, frame)
+    mu = view_cosine(tree, spec, group_in, 1, frame)
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    geometry.name = "Geometry"
+    set_parent(geometry, frame)
+    geometry.location = (FRAME_INSET, -2 * ROW_STEP)
+    chain = Chain(tree, frame, column=2, y=0.0)
+    table = glass["table"]
+    n = clamped_ior(table, chain, group_in.outputs["IOR"])
+    cell, _ = slice_cell(table, chain, r, mu, n)
+    two_closures = node == "glass" and table.get("form") == "two-closures"
+    lobe = "refraction" if two_closures else node
+    entering = slice_read(chain, glass_image(glass, lobe, "entering"), cell, "E entering")
+    leaving = slice_read(chain, glass_image(glass, lobe, "leaving"), cell, "E leaving")
+    albedo = chain.mix_value("E = the back face's (leaving) or the front's (entering)",
+                             geometry.outputs["Backfacing"], entering, leaving)
+    if two_closures:
+        albedo = two_closure_albedo(tree, chain, glass, group_in, cell, n, albedo, frame)
+    gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 2)
+    mix, color_a, color_b, color_out = multiply_color_node(nodes)
+    mix.name = "Apply gain"
+    mix.label = "Color x Gain"
+    mix.width = NODE_WIDTH
+    mix.location = (x, 0.0)
+    links.new(group_in.outputs["Color"], color_a)
+    links.new(gain, color_b)
+    bsdf = nodes.new(kind)
+    bsdf.name = label
+    bsdf.distribution = spec["distribution"]
+    bsdf.width = NODE_WIDTH
+    bsdf.location = (x + COLUMN_STEP, 0.0)
+    links.new(color_out, bsdf.inputs["Color"])
+    links.new(group_in.outputs["Roughness"], bsdf.inputs["Roughness"])
+    links.new(n, bsdf.inputs["IOR"])
+    links.new(group_in.outputs["Normal"], bsdf.inputs["Normal"])
+    group_out = nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    links.new(bsdf.outputs[0], group_out.inputs["BSDF"])
+    description = description_text(spec, params, (
+        "Blender's %s %s (%s) whose colour is divided by E(mu, r, eta), the albedo of one "
+        "rough interface for the view's cosine at the normal it shades with (see '%s'), "
+        "eta = IOR on a front face and 1 / IOR on a back face, read from the packed tables "
+        "'%s ...'. Every interface returns all the light that meets it, entering and "
+        "leaving, so a white solid glass object in an evenly lit white world is 100 %% "
+        "bright. Cycles only."
+        % (spec["distribution"], label, what, spec["normal_group"], glass["image"])))
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "glass"],
+               asset_fields(params, "shader"))
+    return tree
+
 # ======== gloffuse part: groups.py ========
 # ---------------------------------------------------------------------------
 # gloffuse groups.py: build_all(params), the order in which every node group
@@ -2369,11 +2556,14 @@ def group_names(params):
         view = spec.get("view") or {}
         layered = spec.get("layered") or {}
         anisotropic = spec.get("anisotropic") or {}
-        for name in (spec.get("normal_group") if view or layered or anisotropic else None,
+        glass = spec.get("glass") or {}
+        for name in (spec.get("normal_group") if view or layered or anisotropic or glass
+                     else None,
                      spec["correction_group"], spec["shader_group"],
                      view.get("correction_group"), view.get("shader_group"),
                      view.get("multiscatter_group"), layered.get("shader_group"),
-                     anisotropic.get("shader_group")):
+                     anisotropic.get("shader_group"), glass.get("glass_group"),
+                     glass.get("refraction_group")):
             if name is not None and name not in names:
                 names.append(name)
     return names
@@ -2384,7 +2574,8 @@ def build_all(params, on_spec=None):
     (params.py's resolve_params): for each spec the roughness-only pair, and
     with spec["view"] the view pair and/or the multiscatter group it names, and
     with spec["layered"] the layered group, with spec["anisotropic"] the
-    anisotropic group, after the normal group they use
+    anisotropic group, with spec["glass"] the glass and refraction groups,
+    after the normal group they use
     (spec["normal_group"], shared by the specs of one engine). Returns
     [(spec, [trees...]), ...] in document order; a normal group comes first
     with the first spec that uses it. on_spec(spec), if given, is told before
@@ -2413,6 +2604,9 @@ def build_all(params, on_spec=None):
             trees.append(build_layered_group(spec, params))
         if spec.get("anisotropic"):
             trees.append(build_anisotropic_group(spec, params))
+        if spec.get("glass"):
+            trees.append(build_glass_group(spec, params, "glass"))
+            trees.append(build_glass_group(spec, params, "refraction"))
         built.append((spec, trees))
     names = group_names(params)
     for _spec, trees in built:
@@ -2668,6 +2862,8 @@ PREVIEW_COLORS = {
     "multiscatter": (1.0, 0.77, 0.34, 1.0),  # gold: its bounces take the colour
     "layered": (0.8, 0.3, 0.1, 1.0),  # an orange base under a clear coat
     "anisotropic": (0.72, 0.78, 0.9, 1.0),  # brushed steel
+    "glass": (0.85, 0.95, 0.9, 1.0),  # a faint green, as window glass
+    "refraction": (0.85, 0.95, 0.9, 1.0),
 }
 # The anisotropic group's preview stretches its highlight along the default tangent.
 PREVIEW_ANISOTROPY = 0.8
@@ -2808,11 +3004,14 @@ def preview_groups(spec):
     view = spec.get("view") or {}
     layered = spec.get("layered") or {}
     anisotropic = spec.get("anisotropic") or {}
+    glass = spec.get("glass") or {}
     groups = [(spec["shader_group"], "roughness", [spec["correction_group"]]),
               (view.get("shader_group"), "view", [view.get("correction_group")]),
               (view.get("multiscatter_group"), "multiscatter", []),
               (layered.get("shader_group"), "layered", []),
-              (anisotropic.get("shader_group"), "anisotropic", [])]
+              (anisotropic.get("shader_group"), "anisotropic", []),
+              (glass.get("glass_group"), "glass", []),
+              (glass.get("refraction_group"), "refraction", [])]
     return [(name, kind, helpers) for name, kind, helpers in groups if name]
 
 
@@ -2852,7 +3051,8 @@ def render_previews(built, directory, on_preview=None):
             layered = spec.get("layered") or {}
             first_view = (view.get("shader_group") or view.get("multiscatter_group")
                           or layered.get("shader_group")
-                          or (spec.get("anisotropic") or {}).get("shader_group"))
+                          or (spec.get("anisotropic") or {}).get("shader_group")
+                          or (spec.get("glass") or {}).get("glass_group"))
             if normal_name is not None and first_view in shown:
                 first_user.setdefault(normal_name, shown[first_view])
         # A normal group is built with the first spec that uses it, but that spec may

@@ -207,13 +207,23 @@ impl DielectricIntegrator {
     /// (views below 1e-4 of grazing are taken there) at relative index `eta` (> 0).
     pub fn directional_albedo(&self, bsdf: &Dielectric, mu: f64, eta: f64) -> f64 {
         let mu = mu.clamp(1e-4, 1.0);
-        let macro_f = fresnel::dielectric(mu, eta);
-        // The weights of the two lobes: 1 each, or in 3.0–3.5's glass the macro Fresnel.
-        let (wr, wt) = match (bsdf.node, bsdf.form) {
-            (DielectricNode::Refraction, _) => (0.0, 1.0),
-            (DielectricNode::Glass, GlassForm::OneClosure) => (1.0, 1.0),
-            (DielectricNode::Glass, GlassForm::TwoClosures) => (macro_f, (1.0 - macro_f).max(1e-4)),
-        };
+        let (reflected, refracted) = self.lobe_albedos(bsdf, mu, eta);
+        match (bsdf.node, bsdf.form) {
+            (DielectricNode::Glass, GlassForm::TwoClosures) => {
+                // 3.0–3.5 weight the two closures by the Fresnel at the normal.
+                let f = fresnel::dielectric(mu, eta);
+                f * reflected + (1.0 - f).max(1e-4) * refracted
+            }
+            _ => reflected + refracted,
+        }
+    }
+
+    /// What the node's reflected and refracted lobes each return, `(R, T)`: for 3.6 and
+    /// later's glass with the Fresnel of each microfacet in them; for 3.0–3.5's glass before
+    /// the closures' weights (`E = F(μ) R + max(1e-4, 1 − F(μ)) T`, R the Glossy BSDF's
+    /// albedo, whatever η); for the Refraction node `(0, E)`.
+    pub fn lobe_albedos(&self, bsdf: &Dielectric, mu: f64, eta: f64) -> (f64, f64) {
+        let mu = mu.clamp(1e-4, 1.0);
         // A smooth interface, or a matched index (Cycles refracts straight through at
         // |η − 1| < 1e-4): every lobe returns all it is given, except a smooth refraction
         // past the critical angle.
@@ -221,10 +231,15 @@ impl DielectricIntegrator {
         if bsdf.is_smooth() || straight {
             let refracts = straight || (1.0 - mu * mu) < eta * eta;
             let t = if refracts { 1.0 } else { 0.0 };
+            let f = if straight {
+                0.0
+            } else {
+                fresnel::dielectric(mu, eta)
+            };
             return match (bsdf.node, bsdf.form) {
-                (DielectricNode::Refraction, _) => t,
-                (DielectricNode::Glass, GlassForm::OneClosure) => 1.0,
-                (DielectricNode::Glass, GlassForm::TwoClosures) => wr + wt * t,
+                (DielectricNode::Refraction, _) => (0.0, t),
+                (DielectricNode::Glass, GlassForm::OneClosure) => (f, 1.0 - f),
+                (DielectricNode::Glass, GlassForm::TwoClosures) => (1.0, t),
             };
         }
         let v = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
@@ -258,7 +273,7 @@ impl DielectricIntegrator {
                 refracted += weight * t;
             }
         }
-        wr * reflected + wt * refracted
+        (reflected, refracted)
     }
 }
 
@@ -274,6 +289,9 @@ pub struct DielectricGrid {
     /// `[node][side][k][i][j]` flattened: node 0 Glass, 1 Refraction; side 0 entering, 1
     /// leaving.
     values: Vec<f64>,
+    /// `[i][j]`: the reflected lobe's albedo R of 3.0–3.5's glass (whatever η; see
+    /// [`DielectricIntegrator::lobe_albedos`]).
+    reflection: Vec<f64>,
 }
 
 /// Which way the light crosses the interface of a [`DielectricGrid`].
@@ -306,6 +324,11 @@ impl DielectricGrid {
         let side = side as usize;
         self.values[(((node * 2 + side) * coat::SLICES + k) * n + i) * m + j]
     }
+
+    /// `R(μ_i, r_j)` of 3.0–3.5's glass (meaningful for that form only).
+    pub fn reflection(&self, i: usize, j: usize) -> f64 {
+        self.reflection[i * self.roughness.len() + j]
+    }
 }
 
 impl DielectricIntegrator {
@@ -321,9 +344,17 @@ impl DielectricIntegrator {
     ) -> DielectricGrid {
         let ior = coat::slice_iors();
         let (n, m) = (mus.len(), roughness.len());
-        let rows: Vec<Vec<f64>> = mus
+        let rows: Vec<(Vec<f64>, Vec<f64>)> = mus
             .par_iter()
             .map(|&mu| {
+                let reflection = roughness
+                    .iter()
+                    .map(|&r| {
+                        let glass =
+                            Dielectric::new(DielectricNode::Glass, distribution, r, version);
+                        self.lobe_albedos(&glass, mu, 1.5).0
+                    })
+                    .collect();
                 let mut row = vec![0.0; 2 * 2 * coat::SLICES * m];
                 for node in [DielectricNode::Glass, DielectricNode::Refraction] {
                     for side in Side::BOTH {
@@ -339,11 +370,12 @@ impl DielectricIntegrator {
                     }
                 }
                 progress.step();
-                row
+                (row, reflection)
             })
             .collect();
         let mut values = vec![0.0; 2 * 2 * coat::SLICES * n * m];
-        for (i, row) in rows.iter().enumerate() {
+        let reflection = rows.iter().flat_map(|(_, r)| r.iter().copied()).collect();
+        for (i, (row, _)) in rows.iter().enumerate() {
             for (block, chunk) in row.chunks(m).enumerate() {
                 let start = (block * n + i) * m;
                 values[start..start + m].copy_from_slice(chunk);
@@ -354,6 +386,7 @@ impl DielectricIntegrator {
             mu: mus.to_vec(),
             roughness: roughness.iter().map(|r| r.get()).collect(),
             values,
+            reflection,
         }
     }
 }

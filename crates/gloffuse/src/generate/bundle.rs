@@ -67,6 +67,10 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/generate.py"),
     ),
     (
+        "glass_groups",
+        include_str!("../../../../blender/gloffuse_blender/glass_groups.py"),
+    ),
+    (
         "groups",
         include_str!("../../../../blender/gloffuse_blender/groups.py"),
     ),

@@ -8,9 +8,10 @@ use super::catalogs::Catalogs;
 use crate::error::{Error, Field};
 use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
 use crate::measure::anisotropic::AnisotropicAxes;
+use crate::measure::dielectric::Side;
 use crate::measure::{
-    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, Distribution, Engine, Masking,
-    Roughness, coat,
+    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, DielectricIntegrator, DielectricNode,
+    Distribution, Engine, GlassForm, Masking, Roughness, coat,
 };
 use crate::progress::Quiet;
 
@@ -30,15 +31,20 @@ pub enum Mode {
     /// An anisotropic Glossy (`Gloffuse Anisotropic (GGX)`) with gain 1/E(μ, φ, αx, αy),
     /// φ the view's azimuth from the tangent: every pixel of a furnace sphere is 100 %.
     Anisotropic,
+    /// Glass and Refraction BSDFs (`Gloffuse Glass (GGX)`, `Gloffuse Refraction (GGX)`)
+    /// with gain 1/E(μ, r, η), η = IOR on a front face and 1/IOR on a back face: every
+    /// interface returns all the light that meets it.
+    Glass,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 5] = [
+    pub const ALL: [Mode; 6] = [
         Mode::Roughness,
         Mode::View,
         Mode::Multiscatter,
         Mode::Layered,
         Mode::Anisotropic,
+        Mode::Glass,
     ];
 
     pub fn key(self) -> &'static str {
@@ -48,6 +54,7 @@ impl Mode {
             Mode::Multiscatter => "multiscatter",
             Mode::Layered => "layered",
             Mode::Anisotropic => "anisotropic",
+            Mode::Glass => "glass",
         }
     }
 
@@ -187,6 +194,87 @@ impl AnisotropicTable {
     }
 }
 
+/// `E(μ, r, η)` of the glass groups, in the layout of [`CoatTable`] (slices over the index,
+/// row i at μ = i/(size − 1), column j at r = j/(size − 1)), light entering (η = IOR) and
+/// leaving (η = 1/IOR), as the Blenders from `from_version` on within a masking family
+/// render them (the height-correlated family's Blender 3.5 still has 3.0–3.4's glass: it gets
+/// no glass groups). The Refraction node's E is in `refraction_*`. The Glass node's:
+/// - one closure (3.6 on): `glass_*`, E itself;
+/// - two closures (3.0–3.5): `E = F(μ) R + max(1e-4, 1 − F(μ)) T`, T the refraction
+///   lobe's (`refraction_*`) and R the reflection lobe's (`reflection`, the same in every
+///   slice), with the Fresnel F at the normal computed in the group. E itself changes
+///   steeply at the critical angle, which a table over μ would blur.
+#[derive(Clone, Debug, Serialize)]
+pub struct GlassTable {
+    pub size: usize,
+    pub slices: usize,
+    pub ior: Vec<f64>,
+    /// The index of the last slice: the groups clamp their IOR input to [1, this].
+    pub ior_max: f64,
+    /// `z = F0^¼` of the last slice (the first is 0).
+    pub z_max: f64,
+    /// `[major, minor]`: the first Blender of the family whose glass this is.
+    pub from_version: [u32; 2],
+    /// `one-closure` or `two-closures`.
+    pub form: &'static str,
+    /// Image rows, bottom first, each `values[i * size * slices + k * size + j]`.
+    pub refraction_entering: Vec<f32>,
+    pub refraction_leaving: Vec<f32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub glass_entering: Option<Vec<f32>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub glass_leaving: Option<Vec<f32>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflection: Option<Vec<f32>>,
+}
+
+/// Grid points per axis (μ, r) of each index slice of the glass groups' tables.
+pub const GLASS_TABLE_SIZE: usize = 16;
+
+impl GlassTable {
+    /// The table of `distribution` for a masking family: 3.0–3.4's glass (separable) or
+    /// 3.6 and later's (height-correlated).
+    pub fn compute(distribution: Distribution, masking: Masking) -> Self {
+        let from = match masking {
+            Masking::Separable => BlenderVersion::OLDEST,
+            Masking::HeightCorrelated => GlassForm::ONE_CLOSURE_FROM,
+        };
+        let size = GLASS_TABLE_SIZE;
+        let axis = Roughness::grid(size);
+        let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
+        let grid = DielectricIntegrator::default().grid(distribution, from, &mus, &axis, &Quiet);
+        let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
+            let mut values = Vec::with_capacity(size * size * coat::SLICES);
+            for i in 0..size {
+                for k in 0..coat::SLICES {
+                    values.extend((0..size).map(|j| at(k, i, j) as f32));
+                }
+            }
+            values
+        };
+        let e = |node, side| packed(&|k, i, j| grid.e(node, side, k, i, j));
+        let one_closure = GlassForm::of(from) == GlassForm::OneClosure;
+        GlassTable {
+            size,
+            slices: coat::SLICES,
+            ior: grid.ior.to_vec(),
+            ior_max: coat::IOR_MAX,
+            z_max: coat::slice_coordinate(coat::IOR_MAX),
+            from_version: [from.major, from.minor],
+            form: if one_closure {
+                "one-closure"
+            } else {
+                "two-closures"
+            },
+            refraction_entering: e(DielectricNode::Refraction, Side::Entering),
+            refraction_leaving: e(DielectricNode::Refraction, Side::Leaving),
+            glass_entering: one_closure.then(|| e(DielectricNode::Glass, Side::Entering)),
+            glass_leaving: one_closure.then(|| e(DielectricNode::Glass, Side::Leaving)),
+            reflection: (!one_closure).then(|| packed(&|_, i, j| grid.reflection(i, j))),
+        }
+    }
+}
+
 /// E(μ, r) on a grid (row i is μ = i/(height − 1), column j is r = j/(width − 1)) and
 /// E_avg(r) per column.
 #[derive(Clone, Debug, Serialize)]
@@ -257,6 +345,12 @@ pub struct FamilySpec {
     pub anisotropic_image: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub anisotropic_table: Option<AnisotropicTable>,
+    /// The prefix of the packed float images holding `glass_table`'s four tables (glass
+    /// mode): `<prefix> glass entering`, … .
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub glass_image: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub glass_table: Option<GlassTable>,
 }
 
 /// One distribution's node groups, as the Python side builds them. The script picks the
@@ -285,6 +379,12 @@ pub struct GroupSpec {
     /// in the Blenders whose family carries its table: not Beckmann in 3.0–3.4).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub anisotropic_group: Option<String>,
+    /// `Gloffuse Glass (GGX)` and `Gloffuse Refraction (GGX)` (glass mode; a script builds
+    /// them only in the Blenders whose family's table is theirs: not in 3.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub glass_group: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refraction_group: Option<String>,
     pub families: Vec<FamilySpec>,
 }
 
@@ -298,6 +398,7 @@ impl GroupSpec {
             Mode::Multiscatter => view.and_then(|v| v.multiscatter_group.as_deref()),
             Mode::Layered => self.layered_group.as_deref(),
             Mode::Anisotropic => self.anisotropic_group.as_deref(),
+            Mode::Glass => self.glass_group.as_deref(),
         }
     }
 
@@ -310,6 +411,8 @@ impl GroupSpec {
         }
         names.extend(self.layered_group.iter().cloned());
         names.extend(self.anisotropic_group.iter().cloned());
+        names.extend(self.glass_group.iter().cloned());
+        names.extend(self.refraction_group.iter().cloned());
         names
     }
 }
@@ -390,6 +493,16 @@ pub fn anisotropic_group_name(d: Distribution) -> String {
     format!("Gloffuse Anisotropic ({})", d.label())
 }
 
+/// `Gloffuse Glass (GGX)`: the public name of the glass group.
+pub fn glass_group_name(d: Distribution) -> String {
+    format!("Gloffuse Glass ({})", d.label())
+}
+
+/// `Gloffuse Refraction (GGX)`: the public name of the refraction group.
+pub fn refraction_group_name(d: Distribution) -> String {
+    format!("Gloffuse Refraction ({})", d.label())
+}
+
 /// `Gloffuse Multiscatter (GGX)`: the public name of the Glossy + lost-energy group.
 pub fn multiscatter_group_name(engine: Engine, d: Distribution) -> String {
     format!(
@@ -432,6 +545,14 @@ impl GenerateParams {
                 Mode::Anisotropic.key(),
                 "roughness, view or multiscatter for EEVEE: EEVEE renders an anisotropic \
                  Glossy as an isotropic one, so the anisotropic groups are built for Cycles only",
+            ));
+        }
+        if engines.contains(&Engine::Eevee) && modes.contains(&Mode::Glass) {
+            return Err(Error::input(
+                Field::Mode,
+                Mode::Glass.key(),
+                "roughness, view or multiscatter for EEVEE: the glass groups restore the \
+                 energy of Cycles' Glass and Refraction BSDFs, which EEVEE does not render",
             ));
         }
         let mut groups = Vec::new();
@@ -510,10 +631,12 @@ fn group_spec(
     let normal = modes.iter().any(|m| m.per_pixel());
     let views = modes
         .iter()
-        .any(|m| m.per_pixel() && *m != Mode::Anisotropic);
+        .any(|m| m.per_pixel() && !matches!(m, Mode::Anisotropic | Mode::Glass));
     let layered = wants(Mode::Layered);
     // Anisotropic GGX and Beckmann (Ashikhmin–Shirley's anisotropic lobe is another model).
     let anisotropic = wants(Mode::Anisotropic) && d != Distribution::AshikhminShirley;
+    // Blender's Glass and Refraction BSDFs have GGX and Beckmann.
+    let glass = wants(Mode::Glass) && d != Distribution::AshikhminShirley;
     let infix = engine_infix(engine);
     GroupSpec {
         distribution: d,
@@ -523,6 +646,8 @@ fn group_spec(
         normal_group: normal.then(|| normal_group_name(engine)),
         layered_group: layered.then(|| layered_group_name(d)),
         anisotropic_group: anisotropic.then(|| anisotropic_group_name(d)),
+        glass_group: glass.then(|| glass_group_name(d)),
+        refraction_group: glass.then(|| refraction_group_name(d)),
         view: (wants(Mode::View) || wants(Mode::Multiscatter)).then(|| ViewNames {
             correction_group: wants(Mode::View)
                 .then(|| format!("Brightness Correction{infix} View ({})", d.label())),
@@ -558,6 +683,9 @@ fn group_spec(
                     }),
                     anisotropic_table: rendered_anisotropic
                         .then(|| AnisotropicTable::compute(d, *masking)),
+                    glass_image: glass
+                        .then(|| format!("Gloffuse E(mu, r, eta) ({}, {})", d.label(), masking)),
+                    glass_table: glass.then(|| GlassTable::compute(d, *masking)),
                 })
             })
             .collect(),

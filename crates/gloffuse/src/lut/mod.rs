@@ -357,16 +357,11 @@ impl Spec {
             Kind::Anisotropic => {
                 reject_split_sum_flags(args)?;
                 reject_samples(args)?;
-                if distribution == Distribution::AshikhminShirley {
-                    return Err(Error::input(
-                        Field::Distribution,
-                        distribution.key(),
-                        Hint::new(
-                            "ggx or beckmann with {} anisotropic (the table covers the two microfacet distributions)",
-                            [Field::Kind],
-                        ),
-                    ));
-                }
+                microfacet_only(
+                    distribution,
+                    args.kind,
+                    "the table covers the two microfacet distributions",
+                )?;
                 if !blender_version.renders_anisotropic(distribution) {
                     return Err(Error::input(
                         Field::BlenderVersion,
@@ -386,16 +381,11 @@ impl Spec {
             Kind::Glass => {
                 reject_split_sum_flags(args)?;
                 reject_samples(args)?;
-                if distribution == Distribution::AshikhminShirley {
-                    return Err(Error::input(
-                        Field::Distribution,
-                        distribution.key(),
-                        Hint::new(
-                            "ggx or beckmann with {} glass (Blender's Glass and Refraction BSDFs have no Ashikhmin-Shirley)",
-                            [Field::Kind],
-                        ),
-                    ));
-                }
+                microfacet_only(
+                    distribution,
+                    args.kind,
+                    "Blender's Glass and Refraction BSDFs have no Ashikhmin-Shirley",
+                )?;
                 Ok(Spec::Glass {
                     size,
                     distribution,
@@ -470,6 +460,21 @@ impl Spec {
             } => glass::glass_table(size, distribution, blender_version, progress),
         }
     }
+}
+
+/// GGX or Beckmann: the kinds whose table covers only the two microfacet distributions.
+fn microfacet_only(distribution: Distribution, kind: Kind, why: &str) -> Result<(), Error> {
+    if distribution != Distribution::AshikhminShirley {
+        return Ok(());
+    }
+    Err(Error::input(
+        Field::Distribution,
+        distribution.key(),
+        Hint::new(
+            format!("ggx or beckmann with {{}} {} ({why})", kind.key()),
+            [Field::Kind],
+        ),
+    ))
 }
 
 /// The table's size and samples per texel, the kind's defaults where not given, checked

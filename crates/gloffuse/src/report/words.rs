@@ -65,7 +65,7 @@ pub fn scope(mode: Mode) -> &'static str {
              shown, not judged, and red and blue rings in the false colour are expected. \
              View mode corrects every view direction."
         }
-        Mode::View | Mode::Multiscatter | Mode::Anisotropic => {
+        Mode::View | Mode::Multiscatter | Mode::Anisotropic | Mode::Glass => {
             "This mode corrects every view direction, so both the sphere's mean and every \
              view-cosine ring are judged."
         }

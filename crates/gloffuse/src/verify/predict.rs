@@ -160,7 +160,7 @@ impl Predictor {
                 i.directional_albedo(glossy, mu) / i.directional_albedo(calibrated, mu)
             }),
             Mode::Multiscatter => 1.0 + e_avg - i.average_albedo(calibrated),
-            Mode::Layered | Mode::Anisotropic => 1.0,
+            Mode::Layered | Mode::Anisotropic | Mode::Glass => 1.0,
         }
     }
 

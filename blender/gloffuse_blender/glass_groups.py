@@ -1,0 +1,161 @@
+# ---------------------------------------------------------------------------
+# gloffuse glass_groups.py: "Gloffuse Glass (...)" and "Gloffuse Refraction
+# (...)", Blender's own Glass and Refraction BSDFs whose colour is divided by
+# E(mu, r, eta), the albedo of one rough dielectric interface (spec["glass"]).
+#
+# A rough interface returns less light than meets it: the part its single
+# microfacet bounce misses. E is that part's complement, computed by gloffuse
+# for exactly the BSDF this Blender renders (3.0-3.4: two closures weighted
+# by the Fresnel at the normal; 3.6 on: one closure with the Fresnel of each
+# microfacet). eta is the index beyond the surface over the index before it:
+# IOR on a front face (light entering), 1 / IOR on a back face (light leaving,
+# where Cycles shades the inside of the glass). With colour Color / E every
+# interface returns Color of what meets it, entering and leaving, so a white
+# solid glass object in an evenly lit white world is 100 % bright.
+#
+# E travels as packed float images laid out as the layered groups' coat
+# table (layered_groups.py's slice_image), entering and leaving; the group
+# reads both sides at (mu, r, IOR) and takes the one its face needs (Geometry
+# > Backfacing). In 3.0-3.5 the Glass node's E is F R + max(1e-4, 1 - F) T
+# with the Fresnel F at the normal (a Fresnel node, exact where it jumps at
+# the critical angle) and the lobes' R and T from the tables. mu comes from
+# the shading-normal group (normal_group.py).
+#
+# A module of the gloffuse_blender package. Functions and constants only.
+# ---------------------------------------------------------------------------
+from .compat import mark_asset, multiply_color_node, set_parent, set_tree_description
+from .layered_groups import clamped_ior, slice_cell, slice_image, slice_read
+from .nodes import (
+    COLUMN_STEP,
+    FRAME_INSET,
+    NODE_WIDTH,
+    ROW_STEP,
+    Chain,
+    asset_fields,
+    clamped_roughness,
+    description_text,
+    ensure_interface,
+    new_frame,
+    reuse_or_create_group,
+)
+from .normal_group import NORMAL_INPUT, bump_map_correction_inputs
+from .view_groups import view_cosine
+
+# Which Blender node each group wraps, and what it is.
+GLASS_NODES = {
+    "glass": ("ShaderNodeBsdfGlass", "Glass BSDF", "reflection and refraction"),
+    "refraction": ("ShaderNodeBsdfRefraction", "Refraction BSDF", "refraction only"),
+}
+GLASS_IOR_MIN = 1.0
+
+
+def glass_sockets(glass):
+    """Color, Roughness, IOR, Normal [, Bump Map Correction] -> BSDF."""
+    return [
+        {"in_out": "INPUT", "name": "Color", "type": "NodeSocketColor",
+         "default": (1.0, 1.0, 1.0, 1.0), "description": "Colour of the glass"},
+        {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
+         "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness (0..1)"},
+        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
+         "default": 1.5, "min": GLASS_IOR_MIN, "max": float(glass["table"]["ior_max"]),
+         "description": "Index of refraction of the glass (the back faces are its inside)"},
+        NORMAL_INPUT,
+    ] + bump_map_correction_inputs(glass["spec"]) + [
+        {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
+         "description": "Rough dielectric that returns all the light meeting it, both ways"},
+    ]
+
+
+def glass_image(glass, node, side):
+    """The packed float image of E for `node` ("glass" or "refraction") and
+    `side` ("entering" or "leaving")."""
+    key = "%s_%s" % (node, side)
+    return slice_image(glass["table"], key, "%s %s %s" % (glass["image"], node, side),
+                       "glass.table")
+
+
+def two_closure_albedo(tree, chain, glass, group_in, cell, n, refracted, frame):
+    """Blender 3.0-3.5's Glass is two closures weighted by the Fresnel at the
+    normal F: E = F R + max(1e-4, 1 - F) T, R the reflection lobe's albedo
+    (read from the table), T the refraction lobe's (`refracted`). F comes from
+    a Fresnel node, which takes 1 / IOR on a back face as the closures do; in
+    a table over mu it would blur where it jumps to 1 at the critical angle."""
+    reflection = slice_image(glass["table"], "reflection", "%s reflection" % glass["image"],
+                             "glass.table")
+    reflected = slice_read(chain, reflection, cell, "R")
+    fresnel = tree.nodes.new("ShaderNodeFresnel")
+    fresnel.name = "Fresnel at the normal"
+    set_parent(fresnel, frame)
+    fresnel.location = (FRAME_INSET, -3 * ROW_STEP)
+    tree.links.new(n, fresnel.inputs["IOR"])
+    tree.links.new(group_in.outputs["Normal"], fresnel.inputs["Normal"])
+    f = fresnel.outputs["Fac"]
+    weight = chain.math("MAXIMUM", "max(1e-4, 1 - F)", chain.math("SUBTRACT", "1 - F", 1.0, f),
+                        1e-4)
+    return chain.math("MULTIPLY_ADD", "E = F R + max(1e-4, 1 - F) T", f, reflected,
+                      chain.math("MULTIPLY", "max(1e-4, 1 - F) T", weight, refracted))
+
+
+def build_glass_group(spec, params, node):
+    """Color, Roughness, IOR, Normal -> BSDF: Blender's `node` ("glass" or
+    "refraction") of colour Color / E(mu, r, eta)."""
+    glass = spec["glass"]
+    kind, label, what = GLASS_NODES[node]
+    tree = reuse_or_create_group(glass["%s_group" % node])
+    ensure_interface(tree, glass_sockets(dict(glass, spec=spec)))
+    nodes, links = tree.nodes, tree.links
+    group_in = nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+    frame = new_frame(tree, "Albedo frame",
+                      "Gain = 1 / E(mu, r, eta): eta = IOR on a front face, 1 / IOR on a back face")
+    r = clamped_roughness(tree, group_in, frame)
+    mu = view_cosine(tree, spec, group_in, 1, frame)
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    geometry.name = "Geometry"
+    set_parent(geometry, frame)
+    geometry.location = (FRAME_INSET, -2 * ROW_STEP)
+    chain = Chain(tree, frame, column=2, y=0.0)
+    table = glass["table"]
+    n = clamped_ior(table, chain, group_in.outputs["IOR"])
+    cell, _ = slice_cell(table, chain, r, mu, n)
+    two_closures = node == "glass" and table.get("form") == "two-closures"
+    lobe = "refraction" if two_closures else node
+    entering = slice_read(chain, glass_image(glass, lobe, "entering"), cell, "E entering")
+    leaving = slice_read(chain, glass_image(glass, lobe, "leaving"), cell, "E leaving")
+    albedo = chain.mix_value("E = the back face's (leaving) or the front's (entering)",
+                             geometry.outputs["Backfacing"], entering, leaving)
+    if two_closures:
+        albedo = two_closure_albedo(tree, chain, glass, group_in, cell, n, albedo, frame)
+    gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 2)
+    mix, color_a, color_b, color_out = multiply_color_node(nodes)
+    mix.name = "Apply gain"
+    mix.label = "Color x Gain"
+    mix.width = NODE_WIDTH
+    mix.location = (x, 0.0)
+    links.new(group_in.outputs["Color"], color_a)
+    links.new(gain, color_b)
+    bsdf = nodes.new(kind)
+    bsdf.name = label
+    bsdf.distribution = spec["distribution"]
+    bsdf.width = NODE_WIDTH
+    bsdf.location = (x + COLUMN_STEP, 0.0)
+    links.new(color_out, bsdf.inputs["Color"])
+    links.new(group_in.outputs["Roughness"], bsdf.inputs["Roughness"])
+    links.new(n, bsdf.inputs["IOR"])
+    links.new(group_in.outputs["Normal"], bsdf.inputs["Normal"])
+    group_out = nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    links.new(bsdf.outputs[0], group_out.inputs["BSDF"])
+    description = description_text(spec, params, (
+        "Blender's %s %s (%s) whose colour is divided by E(mu, r, eta), the albedo of one "
+        "rough interface for the view's cosine at the normal it shades with (see '%s'), "
+        "eta = IOR on a front face and 1 / IOR on a back face, read from the packed tables "
+        "'%s ...'. Every interface returns all the light that meets it, entering and "
+        "leaving, so a white solid glass object in an evenly lit white world is 100 %% "
+        "bright. Cycles only."
+        % (spec["distribution"], label, what, spec["normal_group"], glass["image"])))
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "glass"],
+               asset_fields(params, "shader"))
+    return tree
