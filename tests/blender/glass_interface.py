@@ -9,8 +9,9 @@
 # CASES.json: {"px": N, "samples": S, "script": optional gloffuse generate
 # script, run first to build its groups in this Blender, "cases": [{"node":
 # "glass" | "refraction", "distribution": "GGX" | "BECKMANN" | "MULTI_GGX",
-# "roughness": r, "ior": n, "inside": bool, "solid": bool, "group": optional
-# name}, ...]}. A case with a "group" is shaded with that node group (white
+# "roughness": r, "ior": n, "inside": bool, "solid": bool, "bump": bool,
+# "group": optional name}, ...]}. A "bump" case takes its normal from Noise
+# (scale 4) > Bump (strength 1, distance 0.3). A case with a "group" is shaded with that node group (white
 # Color, the case's Roughness and IOR); one without, with Blender's own node.
 # Every case: a unit sphere (smooth UV sphere) at the origin, an orthographic
 # camera on -Y looking along +Y with ortho scale 2 (pixel (col, row) sees
@@ -51,6 +52,15 @@ def shader_node(nodes, case):
     node.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     node.inputs["Roughness"].default_value = case["roughness"]
     node.inputs["IOR"].default_value = case["ior"]
+    if case.get("bump"):
+        links = node.id_data.links
+        noise = nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 4.0
+        bump = nodes.new("ShaderNodeBump")
+        bump.inputs["Strength"].default_value = 1.0
+        bump.inputs["Distance"].default_value = 0.3
+        links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        links.new(bump.outputs["Normal"], node.inputs["Normal"])
     return node
 
 
