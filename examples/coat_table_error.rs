@@ -8,6 +8,9 @@
 //!
 //! Run: `cargo run --release --example coat_table_error`
 
+#[path = "shared/xorshift.rs"]
+mod xorshift;
+
 use gloffuse::measure::coat::{coat_albedo, fresnel_average};
 use gloffuse::measure::fresnel;
 use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
@@ -143,13 +146,7 @@ fn atlas_as_packed() {
                 ty,
             )
         };
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = xorshift::uniform();
         let points: Vec<(f64, f64, f64)> = (0..2000)
             .map(|_| (0.05 + 0.95 * next(), next(), 1.0 + 2.0 * next()))
             .collect();

@@ -7,6 +7,9 @@
 //!
 //! Run: `cargo run --release --example glass_table_error`
 
+#[path = "shared/xorshift.rs"]
+mod xorshift;
+
 use gloffuse::generate::params::GlassTable;
 use gloffuse::measure::coat::slice_coordinate;
 use gloffuse::measure::{
@@ -52,13 +55,7 @@ fn main() {
                     s - k as f64,
                 )
             };
-            let mut state = 0x2545_f491_4f6c_dd1du64;
-            let mut next = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 11) as f64 / (1u64 << 53) as f64
-            };
+            let mut next = xorshift::uniform();
             let points: Vec<(f64, f64, f64, bool)> = (0..4000)
                 .map(|_| {
                     (
