@@ -117,27 +117,35 @@ def build_scene(px, samples):
     return scene, sphere
 
 
-def main(argv):
+def render_cases(argv, material_of, build=build_scene, prepare=None):
+    """Render every case of the request argv[0] (see the header) on the scene
+    `build(px, samples)` makes, each with `material_of(case)` (after
+    `prepare(sphere, case)`, if given), and write {"px", "renders"} to argv[1]."""
     with open(argv[0], encoding="utf-8") as handle:
         request = json.load(handle)
     px = int(request["px"])
-    scene, sphere = build_scene(px, int(request["samples"]))
+    scene, sphere = build(px, int(request["samples"]))
     if request.get("script"):
         build_groups(request["script"])
     renders = []
     with tempfile.TemporaryDirectory() as folder:
         for index, case in enumerate(request["cases"]):
+            if prepare is not None:
+                prepare(sphere, case)
             sphere.data.materials.clear()
-            sphere.data.materials.append(anisotropic_material(case))
+            sphere.data.materials.append(material_of(case))
             scene.render.filepath = os.path.join(folder, "case%d.exr" % index)
             bpy.ops.render.render(write_still=True)
             image = bpy.data.images.load(scene.render.filepath)
-            pixels = list(image.pixels[:])
-            renders.append(pixels[0::4])
+            renders.append(list(image.pixels[:])[0::4])
             bpy.data.images.remove(image)
     with open(argv[1], "w", encoding="utf-8") as handle:
         json.dump({"px": px, "renders": renders}, handle)
-    print("GLOFFUSE_RESULT rendered %d spheres" % len(renders))
+    print("GLOFFUSE_RESULT rendered %d cases" % len(renders))
+
+
+def main(argv):
+    render_cases(argv, anisotropic_material)
 
 
 if __name__ == "__main__":

@@ -27,16 +27,14 @@
 # shades as the inside of the glass (index 1/n). OUT.json gets {"px": N,
 # "renders": [[R of every pixel, bottom row first], ...]}.
 # ---------------------------------------------------------------------------
-import json
-import math
 import os
 import sys
-import tempfile
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from anisotropic_sphere import build_groups  # noqa: E402 (after the path it needs)
+from anisotropic_sphere import build_scene as sphere_scene  # noqa: E402 (after the path it needs)
+from anisotropic_sphere import render_cases  # noqa: E402
 
 NODES = {"glass": "ShaderNodeBsdfGlass", "refraction": "ShaderNodeBsdfRefraction"}
 
@@ -93,42 +91,15 @@ def interface_material(case):
 
 
 def build_scene(px, samples):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
-    sphere = bpy.context.object
-    for polygon in sphere.data.polygons:
-        polygon.use_smooth = True
-    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
-    camera.data.type = "ORTHO"
-    camera.data.ortho_scale = 2.0
-    camera.location = (0.0, -5.0, 0.0)
-    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    scene.collection.objects.link(camera)
-    scene.camera = camera
-    world = bpy.data.worlds.new("white")
-    world.use_nodes = True
-    background = world.node_tree.nodes["Background"]
-    background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    background.inputs["Strength"].default_value = 1.0
-    scene.world = world
-    scene.render.engine = "CYCLES"
+    """anisotropic_sphere.py's scene, with nothing blurred or clamped (the
+    BSDF as it is) and 64 bounces of every kind."""
+    scene, sphere = sphere_scene(px, samples)
     cycles = scene.cycles
-    cycles.device = "CPU"
-    cycles.samples = samples
-    cycles.use_denoising = False
-    cycles.filter_width = 0.01
-    # Nothing blurred or clamped: the BSDF as it is.
     cycles.blur_glossy = 0.0
     cycles.sample_clamp_direct = 0.0
     cycles.sample_clamp_indirect = 0.0
     for kind in ("max", "diffuse", "glossy", "transmission", "transparent_max"):
         setattr(cycles, kind + "_bounces", 64)
-    scene.render.resolution_x = scene.render.resolution_y = px
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
     return scene, sphere
 
 
@@ -140,26 +111,8 @@ def set_inside(sphere, inside):
 
 
 def main(argv):
-    with open(argv[0], encoding="utf-8") as handle:
-        request = json.load(handle)
-    px = int(request["px"])
-    scene, sphere = build_scene(px, int(request["samples"]))
-    if request.get("script"):
-        build_groups(request["script"])
-    renders = []
-    with tempfile.TemporaryDirectory() as folder:
-        for index, case in enumerate(request["cases"]):
-            set_inside(sphere, bool(case.get("inside")))
-            sphere.data.materials.clear()
-            sphere.data.materials.append(interface_material(case))
-            scene.render.filepath = os.path.join(folder, "case%d.exr" % index)
-            bpy.ops.render.render(write_still=True)
-            image = bpy.data.images.load(scene.render.filepath)
-            renders.append(list(image.pixels[:])[0::4])
-            bpy.data.images.remove(image)
-    with open(argv[1], "w", encoding="utf-8") as handle:
-        json.dump({"px": px, "renders": renders}, handle)
-    print("GLOFFUSE_RESULT rendered %d interfaces" % len(renders))
+    render_cases(argv, interface_material, build=build_scene,
+                 prepare=lambda sphere, case: set_inside(sphere, bool(case.get("inside"))))
 
 
 if __name__ == "__main__":
