@@ -472,9 +472,39 @@ fn cases() -> Vec<Case> {
         ])
         .writes_nothing_to(&["@/g.py"]),
         // --- verify -------------------------------------------------------------------
-        case(&["verify", "--mode", "glass"])
+        case(&["verify", "--mode", "glass", "--engine", "eevee"])
             .no_blender()
-            .says(&["invalid --mode 'glass'", "tests/glass_e2e.rs"]),
+            .says(&[
+                "invalid --engine 'eevee'",
+                "cycles with --mode glass",
+                "EEVEE renders glass its own way",
+            ]),
+        case(&["verify", "--mode", "glass", "--color", "1,0.5,0.5"])
+            .no_blender()
+            .says(&[
+                "invalid --color '1,0.5,0.5'",
+                "1,1,1 with --mode glass",
+                "tints light at every surface",
+            ]),
+        case(&["verify", "--mode", "glass", "--color-model", "physical"])
+            .no_blender()
+            .says(&[
+                "invalid --color-model 'physical'",
+                "exact with --mode glass",
+            ]),
+        case(&["verify", "--mode", "glass", "--ior", "1.5,1.5"])
+            .no_blender()
+            .says(&["invalid --ior '1.5'", "each index once, from 1 to 3"]),
+        case(&["verify", "--mode", "glass", "--anisotropy", "0.5"])
+            .no_blender()
+            .says(&[
+                "invalid --anisotropy '0.5'",
+                "--anisotropy goes with --mode anisotropic",
+            ]),
+        case(&["verify", "--ior", "1.5"]).no_blender().says(&[
+            "invalid --ior '1.5'",
+            "--ior goes with --mode layered or glass",
+        ]),
         case(&["verify", "--anisotropy", "0.5"])
             .no_blender()
             .says(&[

@@ -120,7 +120,7 @@ fn white_row(
         deviation: (corrected.mean - 1.0).abs(),
         uncorrected,
         corrected,
-        predicted_uncorrected,
+        predicted_uncorrected: Some(predicted_uncorrected),
         predicted_corrected: 1.0,
         ring_targets: vec![[1.0; 3]; RINGS],
         worst_ring: 0.0,
@@ -333,7 +333,7 @@ fn brightness_plot_of_only_nan_values_still_draws() {
     for row in &mut report.rows {
         row.uncorrected_brightness = f64::NAN;
         row.brightness = f64::NAN;
-        row.predicted_uncorrected = f64::NAN;
+        row.predicted_uncorrected = Some(f64::NAN);
         row.predicted_corrected = f64::NAN;
     }
     report.reference.clear();

@@ -22,7 +22,8 @@ use gloffuse::refresh::RefreshOptions;
 use gloffuse::shard::Shard;
 use gloffuse::verify::plan::default_samples;
 use gloffuse::verify::{
-    ANISOTROPIC_SWEEP, Judging, LAYERED_IOR, RenderSettings, VerifyOptions, block_roughness,
+    ANISOTROPIC_SWEEP, GLASS_IOR, Judging, LAYERED_IOR, RenderSettings, VerifyOptions,
+    block_roughness,
 };
 
 const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
@@ -689,12 +690,12 @@ pub struct VerifyArgs {
     pub distribution: Vec<Distribution>,
 
     /// Roughness values of the sweep, comma-separated, each from 0 to 1 and given once
-    /// [default: 0, 0.1, …, 1; layered and anisotropic mode: 0.1, 0.25, 0.5, 0.75, 1].
+    /// [default: 0, 0.1, …, 1; layered, anisotropic and glass mode: 0.1, 0.25, 0.5, 0.75, 1].
     #[arg(long, short = 'r', value_delimiter = ',', value_parser = parse_roughness, allow_hyphen_values = true)]
     pub roughness: Vec<Roughness>,
 
-    /// Layered mode: the coats' indices of refraction, comma-separated, each from 1 to 3
-    /// and given once [default: 1.33,1.5,2].
+    /// Layered and glass mode: the coats' or the glass spheres' indices of refraction,
+    /// comma-separated, each from 1 to 3 and given once [default: 1.33,1.5,2].
     #[arg(long, value_name = "N,...", value_delimiter = ',', value_parser = parse_ior)]
     pub ior: Vec<f64>,
 
@@ -709,7 +710,8 @@ pub struct VerifyArgs {
     pub anisotropy: Vec<f64>,
 
     /// Samples per pixel [default: Cycles 32, which keeps each sphere's standard error
-    /// ≤ 0.2 %; EEVEE 1, its furnace has no noise].
+    /// ≤ 0.2 %; glass mode 256, a solid glass sphere is far noisier; EEVEE 1, its furnace
+    /// has no noise].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub spp: Option<u32>,
 
@@ -717,7 +719,8 @@ pub struct VerifyArgs {
     #[arg(long, default_value_t = verify_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub resolution: u32,
 
-    /// Allowed |mean − 100 %| of a corrected sphere, in percent [default: Cycles 1, EEVEE 2].
+    /// Allowed |mean − 100 %| of a corrected sphere, in percent [default: Cycles 1, EEVEE 2,
+    /// glass mode 2].
     #[arg(long, value_parser = parse_tolerance)]
     pub tolerance: Option<f64>,
 
@@ -728,9 +731,10 @@ pub struct VerifyArgs {
     /// Which correction to check: roughness (gain 100/f(r), judged by each sphere's mean),
     /// view (gain 1/E(μ, r)), multiscatter (Glossy + diffuse (1 − E)), layered (the
     /// glossy-over-diffuse groups at each --ior, next to the hand-made Mix Shader and
-    /// Principled BSDF) or anisotropic (gain 1/E(μ, φ, αx, αy) at each --anisotropy, next to
-    /// Blender's anisotropic Multiscatter GGX; Cycles only), all but the first also judged
-    /// ring by ring.
+    /// Principled BSDF), anisotropic (gain 1/E(μ, φ, αx, αy) at each --anisotropy, next to
+    /// Blender's anisotropic Multiscatter GGX; Cycles only) or glass (solid white Glass BSDF
+    /// spheres at each --ior, 1,024 bounces, next to Multiscatter GGX glass; Cycles only),
+    /// all but the first also judged ring by ring.
     #[arg(long, value_parser = one_of(MODES, Mode::key), default_value = verify_defaults().mode.key())]
     pub mode: Mode,
 
@@ -744,7 +748,7 @@ pub struct VerifyArgs {
     pub color_model: ColorModel,
 
     /// In the view modes: allowed |mean − 100 %| of every view-cosine ring, in percent
-    /// [default: Cycles 1.5, EEVEE 2].
+    /// [default: Cycles 1.5, EEVEE 2, glass mode 3].
     #[arg(long, value_parser = parse_tolerance)]
     pub ring_tolerance: Option<f64>,
 
@@ -917,11 +921,12 @@ impl VerifyArgs {
             distributions: self.distribution.clone(),
             roughness: match (self.roughness.is_empty(), self.mode) {
                 (false, _) => self.roughness.clone(),
-                (true, Mode::Layered | Mode::Anisotropic) => block_roughness(),
+                (true, Mode::Layered | Mode::Anisotropic | Mode::Glass) => block_roughness(),
                 (true, _) => verify_defaults().roughness,
             },
             ior: match (self.ior.is_empty(), self.mode) {
                 (true, Mode::Layered) => LAYERED_IOR.to_vec(),
+                (true, Mode::Glass) => GLASS_IOR.to_vec(),
                 _ => self.ior.clone(),
             },
             anisotropy: match (self.anisotropy.is_empty(), self.mode) {
@@ -930,7 +935,7 @@ impl VerifyArgs {
             },
             render: RenderSettings {
                 cell: self.resolution,
-                samples: self.spp.unwrap_or(default_samples(self.engine)),
+                samples: self.spp.unwrap_or(default_samples(self.engine, self.mode)),
                 seed: self.seed,
                 ..RenderSettings::for_engine(self.engine)
             },
@@ -938,7 +943,7 @@ impl VerifyArgs {
             color: self.color,
             color_model: self.color_model,
             judging: {
-                let defaults = Judging::for_engine(self.engine);
+                let defaults = Judging::for_sweep(self.engine, self.mode);
                 Judging {
                     tolerance_percent: self.tolerance.unwrap_or(defaults.tolerance_percent),
                     ring_tolerance_percent: self

@@ -232,13 +232,24 @@ pub struct GlassTable {
 pub const GLASS_TABLE_SIZE: usize = 16;
 
 impl GlassTable {
+    /// The first Blender of a masking family whose glass the family's table describes.
+    fn first_version(masking: Masking) -> BlenderVersion {
+        match masking {
+            Masking::Separable => BlenderVersion::OLDEST,
+            Masking::HeightCorrelated => GlassForm::ONE_CLOSURE_FROM,
+        }
+    }
+
+    /// Whether the glass groups are built in Blender `version`: in all but 3.5, whose glass
+    /// is 3.4's two closures with the height-correlated masking.
+    pub fn builds_groups_for(version: BlenderVersion) -> bool {
+        version >= Self::first_version(version.masking())
+    }
+
     /// The table of `distribution` for a masking family: 3.0–3.4's glass (separable) or
     /// 3.6 and later's (height-correlated).
     pub fn compute(distribution: Distribution, masking: Masking) -> Self {
-        let from = match masking {
-            Masking::Separable => BlenderVersion::OLDEST,
-            Masking::HeightCorrelated => GlassForm::ONE_CLOSURE_FROM,
-        };
+        let from = Self::first_version(masking);
         let size = GLASS_TABLE_SIZE;
         let axis = Roughness::grid(size);
         let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();

@@ -143,6 +143,7 @@ fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
     // Layered mode compares the hand-made Mix Shader with the layered group.
     let (plain, fixed) = match report.mode {
         crate::generate::Mode::Layered => ("Mix Shader", "layered"),
+        crate::generate::Mode::Glass => ("Glass BSDF", "corrected"),
         _ => ("uncorrected", "corrected"),
     };
     let ring = if report.mode.per_pixel() {

@@ -395,20 +395,21 @@ fn plotted_block(report: &VerifyReport) -> Option<Block> {
 /// Distribution `d`'s points in `block`: uncorrected, its prediction, corrected, its
 /// prediction.
 fn series_points(report: &VerifyReport, d: Distribution, block: Option<Block>) -> [Points; 4] {
-    let pts = |f: fn(&crate::verify::Row) -> f64| {
+    // A value that is not there (glass mode predicts no uncorrected sphere) has no point.
+    let pts = |f: fn(&crate::verify::Row) -> Option<f64>| {
         percent_points(
             report
                 .rows
                 .iter()
                 .filter(|r| r.distribution == d && r.block == block)
-                .map(|r| (r.roughness.get(), f(r))),
+                .filter_map(|r| Some((r.roughness.get(), f(r)?))),
         )
     };
     [
-        pts(|r| r.uncorrected_brightness),
+        pts(|r| Some(r.uncorrected_brightness)),
         pts(|r| r.predicted_uncorrected),
-        pts(|r| r.brightness),
-        pts(|r| r.predicted_corrected),
+        pts(|r| Some(r.brightness)),
+        pts(|r| Some(r.predicted_corrected)),
     ]
 }
 
@@ -450,8 +451,13 @@ fn plot_ranges(
 fn plot_title(report: &VerifyReport, plotted: Option<Block>) -> String {
     match plotted {
         Some(Block::Ior(n)) => format!(
-            "Layered furnace brightness · Blender {} · IOR {n} · {} spp",
-            report.render.blender_version, report.render.samples
+            "{} furnace brightness · Blender {} · IOR {n} · {} spp",
+            match report.mode {
+                Mode::Glass => "Solid glass",
+                _ => "Layered",
+            },
+            report.render.blender_version,
+            report.render.samples
         ),
         Some(Block::Anisotropy(a)) => format!(
             "Anisotropic furnace brightness · Blender {} · anisotropy {a} · {} spp",
@@ -607,7 +613,7 @@ fn draw_distribution<DB: DrawingBackend>(
     d: Distribution,
     [uncorrected, predicted_u, corrected, predicted_c]: &[Points; 4],
     mode: Mode,
-) -> Drawn<[Legend; 5], DB> {
+) -> Drawn<Vec<Legend>, DB> {
     let c = colour(d);
     chart.draw_series(DashedLineSeries::new(
         predicted_u.iter().copied(),
@@ -627,18 +633,25 @@ fn draw_distribution<DB: DrawingBackend>(
     chart.draw_series(corrected.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
     let (uncorrected_name, corrected_name) = match mode {
         Mode::Layered => ("Mix Shader", "layered"),
+        Mode::Glass => ("Glass BSDF", "corrected"),
         _ => ("uncorrected", "corrected"),
     };
-    Ok([
+    let mut legend = vec![
         Legend::Heading(d.label().to_string(), c),
         Legend::Entry(Key::Hollow(c), format!("{uncorrected_name}, rendered")),
-        Legend::Entry(
+    ];
+    // Glass mode predicts no uncorrected sphere: no line, so no key for one.
+    if !predicted_u.is_empty() {
+        legend.push(Legend::Entry(
             Key::Dashed(c.mix(0.6), 2),
             format!("{uncorrected_name}, predicted"),
-        ),
+        ));
+    }
+    legend.extend([
         Legend::Entry(Key::Filled(c), format!("{corrected_name}, rendered")),
         Legend::Entry(Key::Solid(c.into()), format!("{corrected_name}, predicted")),
-    ])
+    ]);
+    Ok(legend)
 }
 
 /// The reference's line and triangles, with their legend.

@@ -14,14 +14,15 @@ pub fn render(report: &VerifyReport) -> String {
     let mut s = String::new();
     write_title(&mut s, report);
     let layered = report.mode == Mode::Layered;
-    // Layered rows name the index too ("Ashikhmin-Shirley, IOR 1.33"), and the references
-    // Principled BSDF.
-    let w = if layered { 30 } else { 18 };
-    if layered {
-        let _ = writeln!(
-            s,
-            "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of what the layered coat promises"
-        );
+    // Rows with an index name it too ("Ashikhmin-Shirley, IOR 1.33"), and so do the
+    // references ("Multiscatter GGX glass, IOR 1.5").
+    let w = if matches!(report.mode, Mode::Layered | Mode::Glass) {
+        32
+    } else {
+        18
+    };
+    if let Some(legend) = legend(report.mode) {
+        let _ = writeln!(s, "{legend}");
     }
     // An EEVEE sweep shows, beside each plain sphere, what Cycles renders for it.
     let eevee = report.engine == Engine::Eevee;
@@ -37,6 +38,22 @@ pub fn render(report: &VerifyReport) -> String {
         let _ = writeln!(s, "log: {}\nrerun: {}", i.log, i.command);
     }
     s
+}
+
+/// What the spheres of a mode are, where the column names do not say it.
+fn legend(mode: Mode) -> Option<&'static str> {
+    match mode {
+        Mode::Layered => Some(
+            "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; \
+             corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of \
+             what the layered coat promises",
+        ),
+        Mode::Glass => Some(
+            "solid spheres, 1,024 bounces: uncorrected = Blender's Glass BSDF; corrected = \
+             Gloffuse Glass; reference = Multiscatter GGX glass",
+        ),
+        _ => None,
+    }
 }
 
 /// How the sweep was rendered, and in which colour when it is not plain white.

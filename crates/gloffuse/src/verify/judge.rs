@@ -165,11 +165,10 @@ mod tests {
 
     fn prediction() -> Prediction {
         Prediction {
-            e_avg: 0.5,
             target: [1.0; 3],
             ring_targets: vec![[1.0; 3]; RINGS],
             uncorrected_base: [1.0; 3],
-            uncorrected: 0.5,
+            uncorrected: Some(0.5),
             corrected: 1.0,
             cycles_uncorrected: None,
         }
@@ -227,6 +226,6 @@ mod tests {
         assert_eq!(r.id, 7);
         assert_eq!(r.roughness, Roughness::new(0.5).unwrap());
         assert_eq!(r.uncorrected_brightness, 0.5);
-        assert_eq!(r.predicted_uncorrected, 0.5);
+        assert_eq!(r.predicted_uncorrected, Some(0.5));
     }
 }

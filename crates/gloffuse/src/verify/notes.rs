@@ -88,7 +88,7 @@ fn display_referred(sweep: &Sweep, rows: &[Row]) -> Option<Note> {
             gain: c.distributions[&w.distribution]
                 .curve
                 .gain(w.roughness.get()),
-            needed_gain: 1.0 / w.predicted_uncorrected,
+            needed_gain: 1.0 / w.predicted_uncorrected?,
         })
     };
     Some(Note::DisplayReferred {
@@ -157,7 +157,7 @@ mod tests {
             uncorrected_brightness: 0.5,
             brightness,
             deviation: (brightness - 1.0).abs(),
-            predicted_uncorrected: 0.5,
+            predicted_uncorrected: Some(0.5),
             cycles_uncorrected: None,
             predicted_corrected: 1.0,
             ring_targets: vec![],

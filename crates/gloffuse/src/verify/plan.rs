@@ -3,8 +3,10 @@
 //! row holds Blender's own energy-conserving answer as the reference. In layered mode the
 //! rows repeat for every index of refraction, "uncorrected" is the Mix Shader artists build
 //! by hand and the reference is Principled BSDF; in anisotropic mode they repeat for every
-//! anisotropy, each sphere's tangent the constant world X. In EEVEE a last cell holds a
-//! white Diffuse sphere: how bright EEVEE's lighting itself is.
+//! anisotropy, each sphere's tangent the constant world X; in glass mode they repeat for
+//! every index of refraction, the spheres are solid Glass BSDFs and the reference is
+//! Multiscatter GGX glass. In EEVEE a last cell holds a white Diffuse sphere: how bright
+//! EEVEE's lighting itself is.
 
 use serde::Serialize;
 use std::path::Path;
@@ -33,6 +35,7 @@ impl Role {
     pub fn label(self, mode: Mode) -> String {
         match (self, mode) {
             (Role::Uncorrected(d), Mode::Layered) => format!("{} Mix Shader", d.label()),
+            (Role::Uncorrected(d), Mode::Glass) => format!("{} Glass BSDF", d.label()),
             (Role::Corrected(d), Mode::Layered) => format!("{} layered", d.label()),
             (Role::Uncorrected(d), _) => format!("{} uncorrected", d.label()),
             (Role::Corrected(d), _) => format!("{} corrected", d.label()),
@@ -80,6 +83,7 @@ impl Block {
 pub fn reference_label(mode: Mode) -> &'static str {
     match mode {
         Mode::Layered => "Principled BSDF",
+        Mode::Glass => "Multiscatter GGX glass",
         _ => "Multiscatter GGX",
     }
 }
@@ -148,7 +152,7 @@ impl RenderSettings {
         RenderSettings {
             engine,
             cell: 64,
-            samples: default_samples(engine),
+            samples: default_samples(engine, Mode::Roughness),
             seed: 0,
             radius_fraction: 0.9,
         }
@@ -157,11 +161,14 @@ impl RenderSettings {
 
 /// Samples per pixel unless told: Cycles 32 keeps the standard error of every sphere's mean
 /// ≤ 0.2 % (measured in 3.4, 4.5 and 5.0 over six seeds; 16 spp reaches 0.5 % in 3.4).
+/// A solid glass sphere is far noisier (its light crosses many surfaces, each multiplying
+/// its weight): at 128 spp GGX r 1 IOR 2 scatters by 0.9 %, so glass takes 256 (5.0.1).
 /// EEVEE's furnace is deterministic: 1, 64 and 256 samples agree within 0.03 %.
-pub fn default_samples(engine: Engine) -> u32 {
-    match engine {
-        Engine::Cycles => 32,
-        Engine::Eevee => 1,
+pub fn default_samples(engine: Engine, mode: Mode) -> u32 {
+    match (engine, mode) {
+        (Engine::Cycles, Mode::Glass) => 256,
+        (Engine::Cycles, _) => 32,
+        (Engine::Eevee, _) => 1,
     }
 }
 
@@ -298,44 +305,13 @@ impl Plan {
         let spheres = self
             .cells
             .iter()
-            .map(|c| {
-                let anisotropy = c.block.and_then(Block::anisotropy);
-                match (c.role, c.block.and_then(Block::ior)) {
-                    (Role::Uncorrected(d), Some(ior)) => SphereSpec::Mix {
-                        distribution: d.blender_enum(),
-                        roughness: c.roughness,
-                        ior,
-                    },
-                    (Role::Uncorrected(d), None) => SphereSpec::Plain {
-                        distribution: d.blender_enum(),
-                        roughness: c.roughness,
-                        anisotropy,
-                    },
-                    (Role::Reference, Some(ior)) => SphereSpec::Principled {
-                        roughness: c.roughness,
-                        ior,
-                    },
-                    (Role::Reference, None) => SphereSpec::Plain {
-                        distribution: "MULTI_GGX",
-                        roughness: c.roughness,
-                        anisotropy,
-                    },
-                    (Role::Lighting, _) => SphereSpec::Diffuse {
-                        roughness: c.roughness,
-                    },
-                    (Role::Corrected(d), ior) => SphereSpec::Group {
-                        group: shader_of(d),
-                        roughness: c.roughness,
-                        ior,
-                        anisotropy,
-                    },
-                }
-            })
+            .map(|c| sphere_spec(c, mode, &shader_of))
             .collect();
         FurnaceParams {
             generate: groups.clone(),
             furnace: FurnaceSection {
                 engine: self.settings.engine,
+                solid: mode == Mode::Glass,
                 cell: self.settings.cell,
                 columns: self.columns,
                 samples: self.settings.samples,
@@ -347,6 +323,52 @@ impl Plan {
                 spheres,
             },
         }
+    }
+}
+
+/// What a cell's sphere is shaded with in `mode`; `group` names a distribution's group.
+fn sphere_spec(c: &Cell, mode: Mode, group: &dyn Fn(Distribution) -> String) -> SphereSpec {
+    let glass = mode == Mode::Glass;
+    let anisotropy = c.block.and_then(Block::anisotropy);
+    match (c.role, c.block.and_then(Block::ior)) {
+        (Role::Uncorrected(d), Some(ior)) if glass => SphereSpec::Glass {
+            distribution: d.blender_enum(),
+            roughness: c.roughness,
+            ior,
+        },
+        (Role::Reference, Some(ior)) if glass => SphereSpec::Glass {
+            distribution: "MULTI_GGX",
+            roughness: c.roughness,
+            ior,
+        },
+        (Role::Uncorrected(d), Some(ior)) => SphereSpec::Mix {
+            distribution: d.blender_enum(),
+            roughness: c.roughness,
+            ior,
+        },
+        (Role::Uncorrected(d), None) => SphereSpec::Plain {
+            distribution: d.blender_enum(),
+            roughness: c.roughness,
+            anisotropy,
+        },
+        (Role::Reference, Some(ior)) => SphereSpec::Principled {
+            roughness: c.roughness,
+            ior,
+        },
+        (Role::Reference, None) => SphereSpec::Plain {
+            distribution: "MULTI_GGX",
+            roughness: c.roughness,
+            anisotropy,
+        },
+        (Role::Lighting, _) => SphereSpec::Diffuse {
+            roughness: c.roughness,
+        },
+        (Role::Corrected(d), ior) => SphereSpec::Group {
+            group: group(d),
+            roughness: c.roughness,
+            ior,
+            anisotropy,
+        },
     }
 }
 
@@ -379,6 +401,12 @@ pub enum SphereSpec {
     },
     /// Principled BSDF at its defaults, a dielectric of index `ior`.
     Principled { roughness: Roughness, ior: f64 },
+    /// A Glass BSDF of index `ior` (on a solid sphere).
+    Glass {
+        distribution: &'static str,
+        roughness: Roughness,
+        ior: f64,
+    },
     /// A Diffuse BSDF of the sweep's colour (roughness 0: Lambert).
     Diffuse { roughness: Roughness },
 }
@@ -386,6 +414,9 @@ pub enum SphereSpec {
 #[derive(Clone, Debug, Serialize)]
 pub struct FurnaceSection {
     pub engine: Engine,
+    /// Whole spheres that see themselves, each at its own depth, and 64 bounces (glass
+    /// mode: light crosses a glass sphere's surfaces many times).
+    pub solid: bool,
     pub cell: u32,
     pub columns: usize,
     pub samples: u32,
@@ -466,6 +497,33 @@ mod tests {
         used.sort();
         used.dedup();
         assert_eq!(used.len(), plan.cells.len());
+    }
+
+    /// An index block is a glass block in glass mode (plain and reference spheres are Glass
+    /// BSDFs) and a coat in layered mode (Mix Shader and Principled BSDF).
+    #[test]
+    fn an_index_block_is_glass_or_a_coat_by_mode() {
+        let plan = Plan::verify(
+            &[Distribution::Ggx],
+            &rs(&[0.5]),
+            &[Block::Ior(1.5)],
+            RenderSettings::default(),
+        );
+        let group = |d: Distribution| format!("group {}", d.key());
+        let spec = |cell: usize, mode| {
+            serde_json::to_value(sphere_spec(&plan.cells[cell], mode, &group)).unwrap()
+        };
+        let (row, reference) = (plan.rows[0], plan.references[0].cell);
+        let glass = serde_json::json!({"shader": "glass", "distribution": "GGX", "roughness": 0.5, "ior": 1.5});
+        assert_eq!(spec(row.uncorrected, Mode::Glass), glass);
+        assert_eq!(spec(reference, Mode::Glass)["distribution"], "MULTI_GGX");
+        let corrected = spec(row.corrected, Mode::Glass);
+        assert_eq!(
+            (&corrected["shader"], &corrected["ior"]),
+            (&"group".into(), &1.5.into())
+        );
+        assert_eq!(spec(row.uncorrected, Mode::Layered)["shader"], "mix");
+        assert_eq!(spec(reference, Mode::Layered)["shader"], "principled");
     }
 
     #[test]

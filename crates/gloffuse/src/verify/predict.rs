@@ -28,9 +28,6 @@ pub struct Predictor {
 /// What the integrator predicts for one (distribution, roughness, block) row.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prediction {
-    /// E_avg(r) of the BSDF the engine renders (layered mode: of the coat; anisotropic
-    /// mode: the mean of E(μ, φ) over the sphere, whose tangent is the world X).
-    pub e_avg: f64,
     /// What the colour model promises the corrected sphere's mean, per channel.
     pub target: [f64; 3],
     /// What it promises each view-cosine ring, in the order of the rings given.
@@ -39,8 +36,10 @@ pub struct Prediction {
     /// layered mode `target`.
     pub uncorrected_base: [f64; 3],
     /// The uncorrected sphere relative to `uncorrected_base`'s promise: E_avg(r), or in
-    /// layered mode the Mix Shader's mean relative to `target`.
-    pub uncorrected: f64,
+    /// layered mode the Mix Shader's mean relative to `target`; none in glass mode (a solid
+    /// glass sphere's light crosses its surfaces many times, which the integrator of one
+    /// interface does not follow).
+    pub uncorrected: Option<f64>,
     /// The corrected sphere relative to `target`.
     pub corrected: f64,
     /// In an EEVEE sweep: E_avg(r) of what Cycles renders for the uncorrected sphere.
@@ -61,6 +60,9 @@ impl Predictor {
     ) -> Prediction {
         if let Some(a) = block.and_then(Block::anisotropy) {
             return self.predict_anisotropic(d, r, a, rings.len());
+        }
+        if self.mode == Mode::Glass {
+            return self.predict_glass(rings.len());
         }
         let ior = block.and_then(Block::ior);
         let i = &self.integrator;
@@ -98,11 +100,10 @@ impl Predictor {
             corrected: self.corrected(curve, r, e_avg, target, &glossy, &calibrated),
             cycles_uncorrected: (self.engine != Engine::Cycles)
                 .then(|| i.average_albedo(&Engine::Cycles.glossy(d, self.masking, r))),
-            e_avg,
             target,
             ring_targets,
             uncorrected_base,
-            uncorrected,
+            uncorrected: Some(uncorrected),
         }
     }
 
@@ -120,11 +121,23 @@ impl Predictor {
             .expect("verify sweeps the distributions with an anisotropic lobe");
         let e_avg = AnisotropicIntegrator::default().constant_tangent_sphere_mean(&lobe);
         Prediction {
-            e_avg,
             target: self.color,
             ring_targets: vec![self.color; rings],
             uncorrected_base: self.color,
-            uncorrected: e_avg,
+            uncorrected: Some(e_avg),
+            corrected: 1.0,
+            cycles_uncorrected: None,
+        }
+    }
+
+    /// A glass row (white, Cycles): the corrected solid sphere and every ring at the
+    /// colour; the uncorrected sphere unpredicted.
+    fn predict_glass(&self, rings: usize) -> Prediction {
+        Prediction {
+            target: self.color,
+            ring_targets: vec![self.color; rings],
+            uncorrected_base: self.color,
+            uncorrected: None,
             corrected: 1.0,
             cycles_uncorrected: None,
         }
@@ -166,8 +179,11 @@ impl Predictor {
 
     /// What the reference sphere at `r` promises: Multiscatter GGX (at any anisotropy)
     /// what a corrected GGX sphere does, Principled BSDF (at the block's index) what a
-    /// layered GGX coat does.
+    /// layered GGX coat does, Multiscatter GGX glass (white) all the light.
     pub fn reference_target(&self, r: Roughness, block: Option<Block>) -> [f64; 3] {
+        if self.mode == Mode::Glass {
+            return self.color;
+        }
         let ggx = self.engine.glossy(Distribution::Ggx, self.masking, r);
         match block.and_then(Block::ior) {
             Some(n) => layered_sphere_target(&Coat::new(&self.integrator, ggx, n), self.color),
