@@ -1,7 +1,8 @@
 //! What the glass groups miss by reading E(μ, r, η) from their packed tables as
 //! `glass_groups.py` does: bilinear in (r, μ) on 16 × 16 grid points, linear between the 12
 //! index slices in z = F0^¼, and in 3.0–3.4's two-closure form `E = F(μ) R + max(1e-4,
-//! 1 − F(μ)) T` with F exact (the group's Fresnel node). Against the integrator, at 4,000
+//! 1 − F(μ)) T` with F exact (the group's Fresnel node) and T leaving read over the cosine
+//! above the critical one (`above_critical_coordinate`). Against the integrator, at 4,000
 //! pseudo-random points per distribution and form: μ in [0.1, 1], r in [0.1, 1], IOR in
 //! [1.1, 2.5], entering and leaving.
 //!
@@ -14,7 +15,7 @@ use gloffuse::generate::params::GlassTable;
 use gloffuse::measure::coat::slice_coordinate;
 use gloffuse::measure::{
     BlenderVersion, Dielectric, DielectricIntegrator, DielectricNode, Distribution, Masking,
-    Roughness, fresnel,
+    Roughness, above_critical_coordinate, fresnel,
 };
 use rayon::prelude::*;
 
@@ -79,8 +80,13 @@ fn main() {
                         (Some(glass), _) => read(glass, mu, r, ior),
                         (None, Some(reflection)) => {
                             let f = fresnel::dielectric(mu, eta);
-                            f * read(reflection, mu, r, ior)
-                                + (1.0 - f).max(1e-4) * read(refraction, mu, r, ior)
+                            let t = match &table.refraction_above_critical {
+                                Some(above) if leaving => {
+                                    read(above, above_critical_coordinate(mu, ior), r, ior)
+                                }
+                                _ => read(refraction, mu, r, ior),
+                            };
+                            f * read(reflection, mu, r, ior) + (1.0 - f).max(1e-4) * t
                         }
                         (None, None) => unreachable!("a glass table has one form"),
                     };

@@ -2,7 +2,9 @@
 //! quadrature sizes: the numbers behind `Quadrature::default()`.
 //! Run: `cargo run --release --example quadrature_error`
 
+// The shared test oracles; this example uses the isotropic one only.
 #[path = "../tests/common/oracle.rs"]
+#[allow(dead_code)]
 mod oracle;
 
 use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness};

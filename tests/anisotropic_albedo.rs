@@ -3,6 +3,9 @@
 //! integrator where the two widths agree, the swap symmetry of X and Y, and the closed form
 //! of GGX at α = 1.
 
+mod common;
+
+use common::oracle::brute_force_anisotropic;
 use glam::DVec3;
 use gloffuse::measure::anisotropic::{local_direction, view};
 use gloffuse::measure::{
@@ -10,7 +13,7 @@ use gloffuse::measure::{
     Roughness,
 };
 use rayon::prelude::*;
-use std::f64::consts::{FRAC_PI_2, LN_2, PI};
+use std::f64::consts::{FRAC_PI_2, LN_2};
 
 const TOLERANCE: f64 = 2e-4;
 const MASKINGS: [Masking; 2] = [Masking::Separable, Masking::HeightCorrelated];
@@ -143,35 +146,6 @@ fn a_mirror_reflects_everything_and_a_sliver_almost_everything() {
         );
         assert!((e - 1.0).abs() < 2e-3, "{d}: {e}");
     }
-}
-
-/// Brute-force anisotropic `E(ωo)`: the same midpoint rule over the half vector as
-/// `common::oracle::brute_force_albedo` (map `tan θh = α tan(πx/2)` with α the geometric mean width), over the
-/// full azimuth, evaluating the public `AnisotropicLobe::eval_cos` (D and G2; the
-/// integrator under test samples the stretched lobe instead and never evaluates D).
-pub fn brute_force_anisotropic(lobe: &AnisotropicLobe, wo: DVec3, nx: usize, nphi: usize) -> f64 {
-    let a = (lobe.alpha_x * lobe.alpha_y).sqrt().max(1e-4);
-    let mut sum = 0.0;
-    for ix in 0..nx {
-        let x = (ix as f64 + 0.5) / nx as f64;
-        let t = (FRAC_PI_2 * x).tan();
-        let theta = (a * t).atan();
-        let dtheta = a * FRAC_PI_2 * (1.0 + t * t) / (1.0 + a * a * t * t);
-        let (st, ct) = theta.sin_cos();
-        let mut ring = 0.0;
-        for ip in 0..nphi {
-            let phi = 2.0 * PI * (ip as f64 + 0.5) / nphi as f64;
-            let h = DVec3::new(st * phi.cos(), st * phi.sin(), ct);
-            let od = wo.dot(h);
-            if od <= 0.0 {
-                continue;
-            }
-            let wi = 2.0 * od * h - wo;
-            ring += lobe.eval_cos(wo, wi) * 4.0 * od;
-        }
-        sum += ring * st * dtheta;
-    }
-    sum * (2.0 * PI / nphi as f64) / nx as f64
 }
 
 /// The sphere mean under a constant world-X tangent (verify's anisotropic spheres) against

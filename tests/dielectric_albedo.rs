@@ -142,3 +142,40 @@ fn a_smooth_interface_and_a_matched_index_return_everything() {
         }
     }
 }
+
+/// The two-closure glass's leaving axis: `u = 0` is the critical cosine, where Snell's law
+/// (sin θ = 1/IOR) and the Fresnel reaching 1 put it, `u = 1` is μ = 1, and the inverse
+/// inverts. Across it, the refraction lobe leaving a nearly smooth glass falls from most
+/// of the light to almost none within 0.02 of μ: what a table over μ (steps of 1/15)
+/// would blur and this axis resolves.
+#[test]
+fn the_leaving_axis_starts_at_the_critical_angle() {
+    use gloffuse::measure::{above_critical, above_critical_coordinate, critical_cosine};
+    for ior in [1.0, 1.1, 1.5, 2.4, 3.0] {
+        let c = critical_cosine(ior);
+        // Snell: the sine of the critical angle is 1/IOR.
+        assert!(
+            ((1.0 - c * c).sqrt() - 1.0 / ior).abs() < 1e-12,
+            "IOR {ior}"
+        );
+        if ior > 1.0 {
+            assert_eq!(fresnel::dielectric(c - 1e-6, 1.0 / ior), 1.0, "IOR {ior}");
+            assert!(fresnel::dielectric(c + 1e-3, 1.0 / ior) < 1.0, "IOR {ior}");
+        }
+        assert!((above_critical(0.0, ior) - c).abs() < 1e-15);
+        assert!((above_critical(1.0, ior) - 1.0).abs() < 1e-15);
+        assert_eq!(above_critical_coordinate(0.5 * c, ior), 0.0);
+        for u in [0.0, 0.1, 0.5, 0.9, 1.0] {
+            let back = above_critical_coordinate(above_critical(u, ior), ior);
+            assert!((back - u).abs() < 1e-9, "IOR {ior} u {u}: {back}");
+        }
+    }
+    let q = DielectricIntegrator::default();
+    let c = critical_cosine(1.5);
+    let lobe = bsdf(DielectricNode::Refraction, Distribution::Ggx, 0.1, "3.4");
+    let (below, above) = (
+        q.directional_albedo(&lobe, c - 0.01, 1.0 / 1.5),
+        q.directional_albedo(&lobe, c + 0.01, 1.0 / 1.5),
+    );
+    assert!(below < 0.2 && above > 0.6, "T {below} → {above}");
+}

@@ -25,16 +25,16 @@ import math
 
 import bpy
 
-from .compat import anisotropic_glossy_node, mark_asset, multiply_color_node, set_parent, set_tree_description
+from .compat import anisotropic_glossy_node, mark_asset, set_parent, set_tree_description
 from .nodes import (
     COLUMN_STEP,
     FRAME_INSET,
-    NODE_WIDTH,
     ROW_STEP,
     Chain,
     asset_fields,
     description_text,
     ensure_interface,
+    gained_bsdf,
     new_frame,
     reuse_or_create_group,
 )
@@ -202,25 +202,13 @@ def build_anisotropic_group(spec, params):
     t = _azimuth(chain, normal, turned, geometry.outputs["Incoming"])
     albedo = _lookup(chain, anisotropic, mu, t, rx, ry)
     gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
-    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
-    mix, color_a, color_b, color_out = multiply_color_node(nodes)
-    mix.name = "Apply gain"
-    mix.label = "Color x Gain"
-    mix.width = NODE_WIDTH
-    mix.location = (x, 0.0)
-    links.new(group_in.outputs["Color"], color_a)
-    links.new(gain, color_b)
     glossy = anisotropic_glossy_node(nodes, spec["distribution"])
     glossy.name = "Anisotropic Glossy BSDF"
-    glossy.width = NODE_WIDTH
-    glossy.location = (x + COLUMN_STEP, 0.0)
-    links.new(color_out, glossy.inputs["Color"])
     for name in ("Roughness", "Anisotropy", "Rotation", "Normal"):
         links.new(group_in.outputs[name], glossy.inputs[name])
     links.new(tangent, glossy.inputs["Tangent"])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
-    links.new(glossy.outputs[0], group_out.inputs["BSDF"])
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
+    gained_bsdf(tree, group_in, gain, glossy, x)
     description = description_text(spec, params, (
         "Blender's anisotropic %s Glossy BSDF whose colour is multiplied by 1 / E(mu, phi, "
         "ax, ay): its albedo for the view's cosine and azimuth from the tangent at the "

@@ -18,35 +18,36 @@
 # reads both sides at (mu, r, IOR) and takes the one its face needs (Geometry
 # > Backfacing). In 3.0-3.5 the Glass node's E is F R + max(1e-4, 1 - F) T
 # with the Fresnel F at the normal (a Fresnel node, exact where it jumps at
-# the critical angle) and the lobes' R and T from the tables. mu comes from
-# the shading-normal group (normal_group.py).
+# the critical angle) and the lobes' R and T from the tables; T falls as
+# steeply there when leaving, so the glass reads it leaving from a table over
+# u, the view cosine above the critical one (mu = mu_c + (1 - mu_c) u^2).
+# mu comes from the shading-normal group (normal_group.py).
 #
 # A module of the gloffuse_blender package. Functions and constants only.
 # ---------------------------------------------------------------------------
-from .compat import mark_asset, multiply_color_node, set_parent, set_tree_description
-from .layered_groups import clamped_ior, slice_cell, slice_image, slice_read
+from .compat import mark_asset, set_parent, set_tree_description
+from .layered_groups import clamped_ior, ior_input, slice_cell, slice_image, slice_read
 from .nodes import (
     COLUMN_STEP,
     FRAME_INSET,
-    NODE_WIDTH,
     ROW_STEP,
     Chain,
     asset_fields,
     clamped_roughness,
     description_text,
     ensure_interface,
+    gained_bsdf,
     new_frame,
     reuse_or_create_group,
 )
 from .normal_group import NORMAL_INPUT, bump_map_correction_inputs
-from .view_groups import view_cosine
+from .view_groups import grid_cell, view_cosine
 
 # Which Blender node each group wraps, and what it is.
 GLASS_NODES = {
     "glass": ("ShaderNodeBsdfGlass", "Glass BSDF", "reflection and refraction"),
     "refraction": ("ShaderNodeBsdfRefraction", "Refraction BSDF", "refraction only"),
 }
-GLASS_IOR_MIN = 1.0
 
 
 def glass_sockets(glass):
@@ -56,9 +57,7 @@ def glass_sockets(glass):
          "default": (1.0, 1.0, 1.0, 1.0), "description": "Colour of the glass"},
         {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
          "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness (0..1)"},
-        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
-         "default": 1.5, "min": GLASS_IOR_MIN, "max": float(glass["table"]["ior_max"]),
-         "description": "Index of refraction of the glass (the back faces are its inside)"},
+        ior_input(glass["table"], "Index of refraction of the glass (the back faces are its inside)"),
         NORMAL_INPUT,
     ] + bump_map_correction_inputs(glass["spec"]) + [
         {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
@@ -68,10 +67,29 @@ def glass_sockets(glass):
 
 def glass_image(glass, node, side):
     """The packed float image of E for `node` ("glass" or "refraction") and
-    `side` ("entering" or "leaving")."""
+    `side` ("entering", "leaving", or for the two-closure glass's refraction
+    lobe leaving "above_critical")."""
     key = "%s_%s" % (node, side)
     return slice_image(glass["table"], key, "%s %s %s" % (glass["image"], node, side),
                        "glass.table")
+
+
+def above_critical(chain, cell, table, mu, n):
+    """The cell of a two-closure table's refraction lobe above the critical
+    angle (the glass's T leaving), whose rows are over u = sqrt((mu - mu_c) / (1 - mu_c)), mu_c = sqrt(1 - 1 / n^2) the
+    cosine below which the back face reflects totally (gloffuse's
+    above_critical): `cell` (slice_cell) with its row and fraction for u."""
+    critical = chain.math("SQRT", "mu_c = sqrt(1 - 1/n^2)",
+                          chain.math("SUBTRACT", "1 - 1/n^2", 1.0,
+                                     chain.math("DIVIDE", "1/n^2", 1.0,
+                                                chain.math("MULTIPLY", "n^2", n, n))))
+    above = chain.math("DIVIDE", "(mu - mu_c) / (1 - mu_c)",
+                       chain.math("SUBTRACT", "mu - mu_c", mu, critical),
+                       chain.math("SUBTRACT", "1 - mu_c", 1.0, critical))
+    u = chain.math("SQRT", "u = sqrt(clamp(...))", chain.clamp("clamp to [0, 1]", above, 0.0, 1.0))
+    row, up = grid_cell(chain, u, int(table["size"]), "u")
+    first, second, _, across, _, t = cell
+    return first, second, row, across, up, t
 
 
 def two_closure_albedo(tree, chain, glass, group_in, cell, n, refracted, frame):
@@ -119,34 +137,25 @@ def build_glass_group(spec, params, node):
     n = clamped_ior(table, chain, group_in.outputs["IOR"])
     cell, _ = slice_cell(table, chain, r, mu, n)
     two_closures = node == "glass" and table.get("form") == "two-closures"
-    lobe = "refraction" if two_closures else node
-    entering = slice_read(chain, glass_image(glass, lobe, "entering"), cell, "E entering")
-    leaving = slice_read(chain, glass_image(glass, lobe, "leaving"), cell, "E leaving")
+    entering = slice_read(chain, glass_image(glass, "refraction" if two_closures else node,
+                                             "entering"), cell, "E entering")
+    if two_closures:
+        leaving = slice_read(chain, glass_image(glass, "refraction", "above_critical"),
+                             above_critical(chain, cell, table, mu, n), "E leaving")
+    else:
+        leaving = slice_read(chain, glass_image(glass, node, "leaving"), cell, "E leaving")
     albedo = chain.mix_value("E = the back face's (leaving) or the front's (entering)",
                              geometry.outputs["Backfacing"], entering, leaving)
     if two_closures:
         albedo = two_closure_albedo(tree, chain, glass, group_in, cell, n, albedo, frame)
     gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
-    x = FRAME_INSET + COLUMN_STEP * (chain.column + 2)
-    mix, color_a, color_b, color_out = multiply_color_node(nodes)
-    mix.name = "Apply gain"
-    mix.label = "Color x Gain"
-    mix.width = NODE_WIDTH
-    mix.location = (x, 0.0)
-    links.new(group_in.outputs["Color"], color_a)
-    links.new(gain, color_b)
     bsdf = nodes.new(kind)
     bsdf.name = label
     bsdf.distribution = spec["distribution"]
-    bsdf.width = NODE_WIDTH
-    bsdf.location = (x + COLUMN_STEP, 0.0)
-    links.new(color_out, bsdf.inputs["Color"])
     links.new(group_in.outputs["Roughness"], bsdf.inputs["Roughness"])
     links.new(n, bsdf.inputs["IOR"])
     links.new(group_in.outputs["Normal"], bsdf.inputs["Normal"])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
-    links.new(bsdf.outputs[0], group_out.inputs["BSDF"])
+    gained_bsdf(tree, group_in, gain, bsdf, FRAME_INSET + COLUMN_STEP * (chain.column + 2))
     description = description_text(spec, params, (
         "Blender's %s %s (%s) whose colour is divided by E(mu, r, eta), the albedo of one "
         "rough interface for the view's cosine at the normal it shades with (see '%s'), "

@@ -68,10 +68,7 @@ def layered_sockets(spec):
          "default": (0.8, 0.8, 0.8, 1.0), "description": "Colour of the diffuse base"},
         {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
          "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness of the coat (0..1)"},
-        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
-         "default": 1.5, "min": LAYERED_IOR_MIN,
-         "max": float(spec["layered"]["coat_table"]["ior_max"]),
-         "description": "Index of refraction of the coat (1 = no coat)"},
+        ior_input(spec["layered"]["coat_table"], "Index of refraction of the coat (1 = no coat)"),
         {"in_out": "INPUT", "name": "Specular Tint", "type": "NodeSocketColor",
          "default": (1.0, 1.0, 1.0, 1.0),
          "description": "Tint of the coat's reflection (the base still gets 1 - A)"},
@@ -90,7 +87,7 @@ def slice_image(table, key, name, where):
     (k + 1) (size - 1) - 1, row i the cells between mu = i / (size - 1) and
     (i + 1) / (size - 1). `where` names the table in errors."""
     size, slices = int(table["size"]), int(table["slices"])
-    values = finite_list(table[key], "%s.%s" % (where, key))
+    values = finite_list(table.get(key), "%s.%s" % (where, key))
     if len(values) != size * slices * size:
         raise ValueError("%s.%s holds %d values, not %d x %d"
                          % (where, key, len(values), size * slices, size))
@@ -102,6 +99,13 @@ def slice_image(table, key, name, where):
         for slice_pixels in packed:
             pixels.extend(slice_pixels[4 * cells * i:4 * cells * (i + 1)])
     return packed_float_image(name, cells * slices, cells, pixels)
+
+
+def ior_input(table, description):
+    """The IOR input of a group reading an index-sliced table: 1.5 by
+    default, from 1 to the table's last slice."""
+    return {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat", "default": 1.5,
+            "min": LAYERED_IOR_MIN, "max": float(table["ior_max"]), "description": description}
 
 
 def clamped_ior(table, chain, ior):

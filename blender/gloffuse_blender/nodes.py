@@ -15,6 +15,7 @@ from .compat import (
     existing_signature_subtype,
     interface_has_panels,
     interface_sockets,
+    multiply_color_node,
     new_socket,
     set_parent,
     set_socket_description,
@@ -255,6 +256,32 @@ def clamped_roughness(tree, group_in, frame, label="r = clamp(Roughness)"):
     clamp.location = (FRAME_INSET, 0.0)
     tree.links.new(group_in.outputs["Roughness"], clamp.inputs["Value"])
     return clamp.outputs[0]
+
+
+def apply_gain(tree, color, gain, location):
+    """A colour multiply "Apply gain": `color` x `gain`, at `location`.
+    Returns its output socket."""
+    mix, color_a, color_b, color_out = multiply_color_node(tree.nodes)
+    mix.name = "Apply gain"
+    mix.label = "Color \u00d7 Gain"
+    mix.width = NODE_WIDTH
+    mix.location = location
+    tree.links.new(color, color_a)
+    tree.links.new(gain, color_b)
+    return color_out
+
+
+def gained_bsdf(tree, group_in, gain, bsdf, x):
+    """The end of a shader group that divides Blender's own BSDF's colour by
+    its albedo: Color x Gain at x, into `bsdf`'s Color one column on, `bsdf`
+    into the group's BSDF output one more on."""
+    color = apply_gain(tree, group_in.outputs["Color"], gain, (x, 0.0))
+    bsdf.width = NODE_WIDTH
+    bsdf.location = (x + COLUMN_STEP, 0.0)
+    tree.links.new(color, bsdf.inputs["Color"])
+    group_out = tree.nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    tree.links.new(bsdf.outputs[0], group_out.inputs["BSDF"])
 
 
 def new_frame(tree, name, label):

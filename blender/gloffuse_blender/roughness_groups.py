@@ -8,13 +8,14 @@
 #   build_correction_group(spec, params) -> correction tree
 #   build_shader_group(spec, params, correction_tree) -> shader tree
 # ---------------------------------------------------------------------------
-from .compat import glossy_node, mark_asset, multiply_color_node, set_parent, set_tree_description
+from .compat import glossy_node, mark_asset, set_parent, set_tree_description
 from .nodes import (
     COLUMN_STEP,
     FRAME_INSET,
     NODE_WIDTH,
     ROW_STEP,
     Chain,
+    apply_gain,
     asset_fields,
     clamped_roughness,
     curve_text,
@@ -189,13 +190,7 @@ def build_correction_group(spec, params):
                                name="Apply gain")
         column = chain.column + 1
     else:
-        mix, color_a, color_b, mix_out = multiply_color_node(nodes)
-        mix.name = "Apply gain"
-        mix.label = "Color \u00d7 Gain"
-        mix.width = NODE_WIDTH
-        mix.location = (col_x() + 50.0, 0.0)
-        links.new(group_in.outputs["Color"], color_a)
-        links.new(gain_out, color_b)
+        mix_out = apply_gain(tree, group_in.outputs["Color"], gain_out, (col_x() + 50.0, 0.0))
 
     group_out = nodes.new("NodeGroupOutput")
     group_out.location = (col_x() + 50.0 + COLUMN_STEP, 0.0)

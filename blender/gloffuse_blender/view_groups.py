@@ -28,6 +28,7 @@ from .nodes import (
     NODE_WIDTH,
     ROW_STEP,
     Chain,
+    apply_gain,
     asset_fields,
     clamped_roughness,
     description_text,
@@ -274,13 +275,7 @@ def build_view_correction_group(spec, params):
                                  name="Apply gain")
         x_end = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
     else:
-        mix, color_a, color_b, color_out = multiply_color_node(nodes)
-        mix.name = "Apply gain"
-        mix.label = "Color × Gain"
-        mix.width = NODE_WIDTH
-        mix.location = (x_end, 0.0)
-        links.new(group_in.outputs["Color"], color_a)
-        links.new(gain.outputs[0], color_b)
+        color_out = apply_gain(tree, group_in.outputs["Color"], gain.outputs[0], (x_end, 0.0))
     group_out = nodes.new("NodeGroupOutput")
     group_out.location = (x_end + COLUMN_STEP, 0.0)
     links.new(color_out, group_out.inputs["Color"])

@@ -2,7 +2,7 @@
 //! the BSDF itself.
 
 use glam::DVec3;
-use gloffuse::measure::Glossy;
+use gloffuse::measure::{AnisotropicLobe, Glossy};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Brute-force `E(μ)`: a plain midpoint rule over the half vector with the map
@@ -26,7 +26,31 @@ pub fn brute_force_weighted(
         return cycles_ashikhmin_shirley(glossy, mu, nx, nphi, weight);
     }
     let wo = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-    let a = glossy.microfacet.alpha.max(1e-4);
+    over_half_vectors(glossy.microfacet.alpha, wo, nx, nphi, &|wi, od| {
+        glossy.eval_cos(wo, wi) * weight(od)
+    })
+}
+
+/// Brute-force anisotropic `E(ωo)`: the same rule over the half vector, α the geometric
+/// mean width, evaluating the public `AnisotropicLobe::eval_cos` (D and G2; the
+/// anisotropic integrator samples the stretched lobe instead and never evaluates D).
+pub fn brute_force_anisotropic(lobe: &AnisotropicLobe, wo: DVec3, nx: usize, nphi: usize) -> f64 {
+    let alpha = (lobe.alpha_x * lobe.alpha_y).sqrt();
+    over_half_vectors(alpha, wo, nx, nphi, &|wi, _| lobe.eval_cos(wo, wi))
+}
+
+/// The midpoint rule both brute forces share: over the half vector h with the map
+/// `tan θh = α tan(πx/2)` and the full azimuth, `∫ f(ωi, ωo·h) · 4 (ωo·h) dh` with ωi the
+/// mirror of ωo about h (`4 (ωo·h)` is the Jacobian from h to ωi); h facing away from ωo
+/// adds nothing.
+fn over_half_vectors(
+    alpha: f64,
+    wo: DVec3,
+    nx: usize,
+    nphi: usize,
+    f: &dyn Fn(DVec3, f64) -> f64,
+) -> f64 {
+    let a = alpha.max(1e-4);
     let mut sum = 0.0;
     for ix in 0..nx {
         let x = (ix as f64 + 0.5) / nx as f64;
@@ -44,7 +68,7 @@ pub fn brute_force_weighted(
                 continue;
             }
             let wi = 2.0 * od * h - wo;
-            ring += glossy.eval_cos(wo, wi) * 4.0 * od * weight(od);
+            ring += f(wi, od) * 4.0 * od;
         }
         sum += ring * st * dtheta;
     }

@@ -727,6 +727,32 @@ def clamped_roughness(tree, group_in, frame, label="r = clamp(Roughness)"):
     return clamp.outputs[0]
 
 
+def apply_gain(tree, color, gain, location):
+    """A colour multiply "Apply gain": `color` x `gain`, at `location`.
+    Returns its output socket."""
+    mix, color_a, color_b, color_out = multiply_color_node(tree.nodes)
+    mix.name = "Apply gain"
+    mix.label = "Color \u00d7 Gain"
+    mix.width = NODE_WIDTH
+    mix.location = location
+    tree.links.new(color, color_a)
+    tree.links.new(gain, color_b)
+    return color_out
+
+
+def gained_bsdf(tree, group_in, gain, bsdf, x):
+    """The end of a shader group that divides Blender's own BSDF's colour by
+    its albedo: Color x Gain at x, into `bsdf`'s Color one column on, `bsdf`
+    into the group's BSDF output one more on."""
+    color = apply_gain(tree, group_in.outputs["Color"], gain, (x, 0.0))
+    bsdf.width = NODE_WIDTH
+    bsdf.location = (x + COLUMN_STEP, 0.0)
+    tree.links.new(color, bsdf.inputs["Color"])
+    group_out = tree.nodes.new("NodeGroupOutput")
+    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
+    tree.links.new(bsdf.outputs[0], group_out.inputs["BSDF"])
+
+
 def new_frame(tree, name, label):
     """The shrinking frame, at the origin (see compat.py's set_parent), that
     holds a group's arithmetic."""
@@ -1481,13 +1507,7 @@ def build_correction_group(spec, params):
                                name="Apply gain")
         column = chain.column + 1
     else:
-        mix, color_a, color_b, mix_out = multiply_color_node(nodes)
-        mix.name = "Apply gain"
-        mix.label = "Color \u00d7 Gain"
-        mix.width = NODE_WIDTH
-        mix.location = (col_x() + 50.0, 0.0)
-        links.new(group_in.outputs["Color"], color_a)
-        links.new(gain_out, color_b)
+        mix_out = apply_gain(tree, group_in.outputs["Color"], gain_out, (col_x() + 50.0, 0.0))
 
     group_out = nodes.new("NodeGroupOutput")
     group_out.location = (col_x() + 50.0 + COLUMN_STEP, 0.0)
@@ -1807,13 +1827,7 @@ def build_view_correction_group(spec, params):
                                  name="Apply gain")
         x_end = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
     else:
-        mix, color_a, color_b, color_out = multiply_color_node(nodes)
-        mix.name = "Apply gain"
-        mix.label = "Color × Gain"
-        mix.width = NODE_WIDTH
-        mix.location = (x_end, 0.0)
-        links.new(group_in.outputs["Color"], color_a)
-        links.new(gain.outputs[0], color_b)
+        color_out = apply_gain(tree, group_in.outputs["Color"], gain.outputs[0], (x_end, 0.0))
     group_out = nodes.new("NodeGroupOutput")
     group_out.location = (x_end + COLUMN_STEP, 0.0)
     links.new(color_out, group_out.inputs["Color"])
@@ -2086,25 +2100,13 @@ def build_anisotropic_group(spec, params):
     t = _azimuth(chain, normal, turned, geometry.outputs["Incoming"])
     albedo = _lookup(chain, anisotropic, mu, t, rx, ry)
     gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
-    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
-    mix, color_a, color_b, color_out = multiply_color_node(nodes)
-    mix.name = "Apply gain"
-    mix.label = "Color x Gain"
-    mix.width = NODE_WIDTH
-    mix.location = (x, 0.0)
-    links.new(group_in.outputs["Color"], color_a)
-    links.new(gain, color_b)
     glossy = anisotropic_glossy_node(nodes, spec["distribution"])
     glossy.name = "Anisotropic Glossy BSDF"
-    glossy.width = NODE_WIDTH
-    glossy.location = (x + COLUMN_STEP, 0.0)
-    links.new(color_out, glossy.inputs["Color"])
     for name in ("Roughness", "Anisotropy", "Rotation", "Normal"):
         links.new(group_in.outputs[name], glossy.inputs[name])
     links.new(tangent, glossy.inputs["Tangent"])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
-    links.new(glossy.outputs[0], group_out.inputs["BSDF"])
+    x = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
+    gained_bsdf(tree, group_in, gain, glossy, x)
     description = description_text(spec, params, (
         "Blender's anisotropic %s Glossy BSDF whose colour is multiplied by 1 / E(mu, phi, "
         "ax, ay): its albedo for the view's cosine and azimuth from the tangent at the "
@@ -2162,10 +2164,7 @@ def layered_sockets(spec):
          "default": (0.8, 0.8, 0.8, 1.0), "description": "Colour of the diffuse base"},
         {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
          "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness of the coat (0..1)"},
-        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
-         "default": 1.5, "min": LAYERED_IOR_MIN,
-         "max": float(spec["layered"]["coat_table"]["ior_max"]),
-         "description": "Index of refraction of the coat (1 = no coat)"},
+        ior_input(spec["layered"]["coat_table"], "Index of refraction of the coat (1 = no coat)"),
         {"in_out": "INPUT", "name": "Specular Tint", "type": "NodeSocketColor",
          "default": (1.0, 1.0, 1.0, 1.0),
          "description": "Tint of the coat's reflection (the base still gets 1 - A)"},
@@ -2184,7 +2183,7 @@ def slice_image(table, key, name, where):
     (k + 1) (size - 1) - 1, row i the cells between mu = i / (size - 1) and
     (i + 1) / (size - 1). `where` names the table in errors."""
     size, slices = int(table["size"]), int(table["slices"])
-    values = finite_list(table[key], "%s.%s" % (where, key))
+    values = finite_list(table.get(key), "%s.%s" % (where, key))
     if len(values) != size * slices * size:
         raise ValueError("%s.%s holds %d values, not %d x %d"
                          % (where, key, len(values), size * slices, size))
@@ -2196,6 +2195,13 @@ def slice_image(table, key, name, where):
         for slice_pixels in packed:
             pixels.extend(slice_pixels[4 * cells * i:4 * cells * (i + 1)])
     return packed_float_image(name, cells * slices, cells, pixels)
+
+
+def ior_input(table, description):
+    """The IOR input of a group reading an index-sliced table: 1.5 by
+    default, from 1 to the table's last slice."""
+    return {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat", "default": 1.5,
+            "min": LAYERED_IOR_MIN, "max": float(table["ior_max"]), "description": description}
 
 
 def clamped_ior(table, chain, ior):
@@ -2409,8 +2415,10 @@ COAT_DESCRIPTIONS = {
 # reads both sides at (mu, r, IOR) and takes the one its face needs (Geometry
 # > Backfacing). In 3.0-3.5 the Glass node's E is F R + max(1e-4, 1 - F) T
 # with the Fresnel F at the normal (a Fresnel node, exact where it jumps at
-# the critical angle) and the lobes' R and T from the tables. mu comes from
-# the shading-normal group (normal_group.py).
+# the critical angle) and the lobes' R and T from the tables; T falls as
+# steeply there when leaving, so the glass reads it leaving from a table over
+# u, the view cosine above the critical one (mu = mu_c + (1 - mu_c) u^2).
+# mu comes from the shading-normal group (normal_group.py).
 #
 # A module of the gloffuse_blender package. Functions and constants only.
 # ---------------------------------------------------------------------------
@@ -2420,7 +2428,6 @@ GLASS_NODES = {
     "glass": ("ShaderNodeBsdfGlass", "Glass BSDF", "reflection and refraction"),
     "refraction": ("ShaderNodeBsdfRefraction", "Refraction BSDF", "refraction only"),
 }
-GLASS_IOR_MIN = 1.0
 
 
 def glass_sockets(glass):
@@ -2430,9 +2437,7 @@ def glass_sockets(glass):
          "default": (1.0, 1.0, 1.0, 1.0), "description": "Colour of the glass"},
         {"in_out": "INPUT", "name": "Roughness", "type": "NodeSocketFloat", "subtype": "FACTOR",
          "default": 0.5, "min": 0.0, "max": 1.0, "description": "Roughness (0..1)"},
-        {"in_out": "INPUT", "name": "IOR", "type": "NodeSocketFloat",
-         "default": 1.5, "min": GLASS_IOR_MIN, "max": float(glass["table"]["ior_max"]),
-         "description": "Index of refraction of the glass (the back faces are its inside)"},
+        ior_input(glass["table"], "Index of refraction of the glass (the back faces are its inside)"),
         NORMAL_INPUT,
     ] + bump_map_correction_inputs(glass["spec"]) + [
         {"in_out": "OUTPUT", "name": "BSDF", "type": "NodeSocketShader",
@@ -2442,10 +2447,29 @@ def glass_sockets(glass):
 
 def glass_image(glass, node, side):
     """The packed float image of E for `node` ("glass" or "refraction") and
-    `side` ("entering" or "leaving")."""
+    `side` ("entering", "leaving", or for the two-closure glass's refraction
+    lobe leaving "above_critical")."""
     key = "%s_%s" % (node, side)
     return slice_image(glass["table"], key, "%s %s %s" % (glass["image"], node, side),
                        "glass.table")
+
+
+def above_critical(chain, cell, table, mu, n):
+    """The cell of a two-closure table's refraction lobe above the critical
+    angle (the glass's T leaving), whose rows are over u = sqrt((mu - mu_c) / (1 - mu_c)), mu_c = sqrt(1 - 1 / n^2) the
+    cosine below which the back face reflects totally (gloffuse's
+    above_critical): `cell` (slice_cell) with its row and fraction for u."""
+    critical = chain.math("SQRT", "mu_c = sqrt(1 - 1/n^2)",
+                          chain.math("SUBTRACT", "1 - 1/n^2", 1.0,
+                                     chain.math("DIVIDE", "1/n^2", 1.0,
+                                                chain.math("MULTIPLY", "n^2", n, n))))
+    above = chain.math("DIVIDE", "(mu - mu_c) / (1 - mu_c)",
+                       chain.math("SUBTRACT", "mu - mu_c", mu, critical),
+                       chain.math("SUBTRACT", "1 - mu_c", 1.0, critical))
+    u = chain.math("SQRT", "u = sqrt(clamp(...))", chain.clamp("clamp to [0, 1]", above, 0.0, 1.0))
+    row, up = grid_cell(chain, u, int(table["size"]), "u")
+    first, second, _, across, _, t = cell
+    return first, second, row, across, up, t
 
 
 def two_closure_albedo(tree, chain, glass, group_in, cell, n, refracted, frame):
@@ -2493,34 +2517,25 @@ def build_glass_group(spec, params, node):
     n = clamped_ior(table, chain, group_in.outputs["IOR"])
     cell, _ = slice_cell(table, chain, r, mu, n)
     two_closures = node == "glass" and table.get("form") == "two-closures"
-    lobe = "refraction" if two_closures else node
-    entering = slice_read(chain, glass_image(glass, lobe, "entering"), cell, "E entering")
-    leaving = slice_read(chain, glass_image(glass, lobe, "leaving"), cell, "E leaving")
+    entering = slice_read(chain, glass_image(glass, "refraction" if two_closures else node,
+                                             "entering"), cell, "E entering")
+    if two_closures:
+        leaving = slice_read(chain, glass_image(glass, "refraction", "above_critical"),
+                             above_critical(chain, cell, table, mu, n), "E leaving")
+    else:
+        leaving = slice_read(chain, glass_image(glass, node, "leaving"), cell, "E leaving")
     albedo = chain.mix_value("E = the back face's (leaving) or the front's (entering)",
                              geometry.outputs["Backfacing"], entering, leaving)
     if two_closures:
         albedo = two_closure_albedo(tree, chain, glass, group_in, cell, n, albedo, frame)
     gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
-    x = FRAME_INSET + COLUMN_STEP * (chain.column + 2)
-    mix, color_a, color_b, color_out = multiply_color_node(nodes)
-    mix.name = "Apply gain"
-    mix.label = "Color x Gain"
-    mix.width = NODE_WIDTH
-    mix.location = (x, 0.0)
-    links.new(group_in.outputs["Color"], color_a)
-    links.new(gain, color_b)
     bsdf = nodes.new(kind)
     bsdf.name = label
     bsdf.distribution = spec["distribution"]
-    bsdf.width = NODE_WIDTH
-    bsdf.location = (x + COLUMN_STEP, 0.0)
-    links.new(color_out, bsdf.inputs["Color"])
     links.new(group_in.outputs["Roughness"], bsdf.inputs["Roughness"])
     links.new(n, bsdf.inputs["IOR"])
     links.new(group_in.outputs["Normal"], bsdf.inputs["Normal"])
-    group_out = nodes.new("NodeGroupOutput")
-    group_out.location = (x + 2 * COLUMN_STEP, 0.0)
-    links.new(bsdf.outputs[0], group_out.inputs["BSDF"])
+    gained_bsdf(tree, group_in, gain, bsdf, FRAME_INSET + COLUMN_STEP * (chain.column + 2))
     description = description_text(spec, params, (
         "Blender's %s %s (%s) whose colour is divided by E(mu, r, eta), the albedo of one "
         "rough interface for the view's cosine at the normal it shades with (see '%s'), "

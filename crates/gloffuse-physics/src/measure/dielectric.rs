@@ -277,6 +277,28 @@ impl DielectricIntegrator {
     }
 }
 
+/// The view cosine below which light leaving a glass of index `ior` reflects totally at
+/// the normal: `√(1 − 1/IOR²)` (0 for an index of 1).
+pub fn critical_cosine(ior: f64) -> f64 {
+    (1.0 - 1.0 / (ior * ior)).max(0.0).sqrt()
+}
+
+/// The leaving side's table axis of the two-closure glass, for the refraction lobe: `u` in
+/// [0, 1] is the view cosine `μ = μc + (1 − μc) u²` above the critical one `μc`. That lobe
+/// falls from about 1 to 0 within a few hundredths of μ at `μc` (below it the lobe weighs
+/// 1e-4 and hardly matters), which a table over μ blurs and this axis resolves: at every
+/// index the fall sits at `u = 0`, where the grid points crowd.
+pub fn above_critical(u: f64, ior: f64) -> f64 {
+    let c = critical_cosine(ior);
+    c + (1.0 - c) * u * u
+}
+
+/// [`above_critical`]'s inverse: the `u` of view cosine `mu` (0 below the critical cosine).
+pub fn above_critical_coordinate(mu: f64, ior: f64) -> f64 {
+    let c = critical_cosine(ior);
+    ((mu - c) / (1.0 - c)).clamp(0.0, 1.0).sqrt()
+}
+
 /// `E(μ, r, η)` of the Glass and Refraction nodes of one distribution and Blender version on
 /// a grid: μ and r on the given axes, η on the coat tables' index slices
 /// ([`coat::slice_iors`], 1 to [`coat::IOR_MAX`], even in `z = F0^¼`), entering (η = IOR)

@@ -20,7 +20,10 @@ pub mod version;
 
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
 pub use anisotropic::{AnisotropicIntegrator, AnisotropicLobe, Anisotropy};
-pub use dielectric::{Dielectric, DielectricIntegrator, DielectricNode, GlassForm};
+pub use dielectric::{
+    Dielectric, DielectricIntegrator, DielectricNode, GlassForm, above_critical,
+    above_critical_coordinate, critical_cosine,
+};
 pub use engine::Engine;
 pub use glossy::Glossy;
 pub use microfacet::{Distribution, Masking, Microfacet, Polar, Roughness};

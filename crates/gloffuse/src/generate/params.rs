@@ -10,10 +10,11 @@ use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
 use crate::measure::anisotropic::AnisotropicAxes;
 use crate::measure::dielectric::Side;
 use crate::measure::{
-    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, DielectricIntegrator, DielectricNode,
-    Distribution, Engine, GlassForm, Masking, Roughness, coat,
+    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, Dielectric, DielectricIntegrator,
+    DielectricNode, Distribution, Engine, GlassForm, Masking, Roughness, above_critical, coat,
 };
 use crate::progress::Quiet;
+use rayon::prelude::*;
 
 /// Which correction a shader group applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -203,7 +204,11 @@ impl AnisotropicTable {
 /// - two closures (3.0–3.5): `E = F(μ) R + max(1e-4, 1 − F(μ)) T`, T the refraction
 ///   lobe's (`refraction_*`) and R the reflection lobe's (`reflection`, the same in every
 ///   slice), with the Fresnel F at the normal computed in the group. E itself changes
-///   steeply at the critical angle, which a table over μ would blur.
+///   steeply at the critical angle, which a table over μ would blur. So does T on the
+///   leaving side, so the glass reads it from `refraction_above_critical`, whose rows are
+///   over [`above_critical`]'s `u` (row i at `u = i/(size − 1)`, each slice its own
+///   critical cosine), not μ. (The Refraction node keeps `refraction_leaving` over μ: for
+///   it, T below the critical cosine is all there is.)
 #[derive(Clone, Debug, Serialize)]
 pub struct GlassTable {
     pub size: usize,
@@ -226,6 +231,8 @@ pub struct GlassTable {
     pub glass_leaving: Option<Vec<f32>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reflection: Option<Vec<f32>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refraction_above_critical: Option<Vec<f32>>,
 }
 
 /// Grid points per axis (μ, r) of each index slice of the glass groups' tables.
@@ -265,6 +272,10 @@ impl GlassTable {
         };
         let e = |node, side| packed(&|k, i, j| grid.e(node, side, k, i, j));
         let one_closure = GlassForm::of(from) == GlassForm::OneClosure;
+        let above_critical = (!one_closure).then(|| {
+            let rows = refraction_above_critical(distribution, from, &grid.ior, &axis);
+            packed(&|k, i, j| rows[i][k][j])
+        });
         GlassTable {
             size,
             slices: coat::SLICES,
@@ -279,11 +290,43 @@ impl GlassTable {
             },
             refraction_entering: e(DielectricNode::Refraction, Side::Entering),
             refraction_leaving: e(DielectricNode::Refraction, Side::Leaving),
+            refraction_above_critical: above_critical,
             glass_entering: one_closure.then(|| e(DielectricNode::Glass, Side::Entering)),
             glass_leaving: one_closure.then(|| e(DielectricNode::Glass, Side::Leaving)),
             reflection: (!one_closure).then(|| packed(&|_, i, j| grid.reflection(i, j))),
         }
     }
+}
+
+/// The two-closure refraction lobe's albedo leaving a glass, `[i][k][j]`: at `u_i` above
+/// slice k's critical cosine ([`above_critical`]), roughness `r_j`, η = 1/IOR_k.
+fn refraction_above_critical(
+    distribution: Distribution,
+    version: BlenderVersion,
+    ior: &[f64],
+    axis: &[Roughness],
+) -> Vec<Vec<Vec<f64>>> {
+    let q = DielectricIntegrator::default();
+    axis.par_iter()
+        .map(|u| {
+            ior.iter()
+                .map(|&n| {
+                    let mu = above_critical(u.get(), n).max(1e-3);
+                    axis.iter()
+                        .map(|&r| {
+                            let lobe = Dielectric::new(
+                                DielectricNode::Refraction,
+                                distribution,
+                                r,
+                                version,
+                            );
+                            q.directional_albedo(&lobe, mu, 1.0 / n)
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// E(μ, r) on a grid (row i is μ = i/(height − 1), column j is r = j/(width − 1)) and
@@ -786,4 +829,52 @@ fn in_the_other_engine(engine: Engine, d: Distribution, masking: Masking) -> Str
 }
 fn as_blender_enum<S: serde::Serializer>(d: &Distribution, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(d.blender_enum())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::critical_cosine;
+
+    /// The two-closure table's refraction lobe above the critical angle sits above each
+    /// slice's critical cosine (row 0 at it, the last at μ = 1); the leaving refraction
+    /// rows of both forms are over μ.
+    #[test]
+    fn the_two_closure_leaving_rows_start_at_the_critical_angle() {
+        let q = DielectricIntegrator::default();
+        let n = GLASS_TABLE_SIZE;
+        for (masking, version) in [
+            (Masking::Separable, BlenderVersion::OLDEST),
+            (Masking::HeightCorrelated, GlassForm::ONE_CLOSURE_FROM),
+        ] {
+            let table = GlassTable::compute(Distribution::Ggx, masking);
+            let tables = [(Some(&table.refraction_leaving), false)]
+                .into_iter()
+                .chain([(table.refraction_above_critical.as_ref(), true)]);
+            assert_eq!(
+                table.refraction_above_critical.is_some(),
+                masking == Masking::Separable
+            );
+            for ((values, above), (i, k, j)) in tables
+                .filter_map(|(v, above)| Some((v?, above)))
+                .flat_map(|t| [(t, (0, 6, 2)), (t, (3, 11, 15)), (t, (15, 4, 8))])
+            {
+                let (ior, x) = (table.ior[k], i as f64 / (n - 1) as f64);
+                let mu = if above {
+                    critical_cosine(ior) + (1.0 - critical_cosine(ior)) * x * x
+                } else {
+                    x
+                };
+                let r = Roughness::new(j as f64 / (n - 1) as f64).unwrap();
+                let lobe =
+                    Dielectric::new(DielectricNode::Refraction, Distribution::Ggx, r, version);
+                let want = q.directional_albedo(&lobe, mu.max(1e-3), 1.0 / ior) as f32;
+                let got = values[(i * table.slices + k) * n + j];
+                assert!(
+                    (got - want).abs() < 1e-6,
+                    "{masking:?} ({i}, {k}, {j}): {got} vs {want}"
+                );
+            }
+        }
+    }
 }
