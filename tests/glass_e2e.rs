@@ -21,8 +21,7 @@ const RINGS: usize = 5;
 /// and 5.0. Blender 3.4 renders a little more than its lobes return in two places: inside
 /// the glass past the critical angle (GGX: 0.004, where the refraction closure weighs 1e-4
 /// but is still picked), and with Beckmann (up to 0.013; its sampler draws the visible
-/// normals from a table and masks the view with the exact Λ, while it weights with
-/// Walter's approximation).
+/// normals from a table, docs/PHYSICS.md §15).
 fn ring_tolerance(version: &str, d: Distribution) -> f64 {
     match (version, d) {
         ("3.4", Distribution::Beckmann) => 0.015,
