@@ -60,8 +60,10 @@ FURNACE_CAMERA_HEIGHT = 10.0
 # 0.08 % of its sky, and they return most of that light anyway.
 FURNACE_SOLID_SPACING = 16.0
 
-# A solid glass sphere keeps light inside for many bounces: at IOR 2.4 and
-# roughness 0.6 (Blender 5.0.1) 16 bounces render 94 % of what 64 and 256 do.
+# A solid glass sphere keeps light inside for many bounces, nearly smooth
+# dense glass for hundreds (total internal reflection): the GGX group at IOR
+# 2.4, roughness 0.1 (Blender 5.0.1) renders 98.6 % with 64, 99.5 % with 256
+# and 99.95 % with 1,024, Cycles' largest, which costs little more.
 FURNACE_SOLID_BOUNCES = 1024
 
 

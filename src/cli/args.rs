@@ -22,8 +22,7 @@ use gloffuse::refresh::RefreshOptions;
 use gloffuse::shard::Shard;
 use gloffuse::verify::plan::default_samples;
 use gloffuse::verify::{
-    ANISOTROPIC_SWEEP, GLASS_IOR, Judging, LAYERED_IOR, RenderSettings, VerifyOptions,
-    block_roughness,
+    ANISOTROPIC_SWEEP, IOR_SWEEP, Judging, RenderSettings, VerifyOptions, block_roughness,
 };
 
 const ABOUT: &str = "Keep Blender's glossy shaders at full brightness.";
@@ -925,8 +924,7 @@ impl VerifyArgs {
                 (true, _) => verify_defaults().roughness,
             },
             ior: match (self.ior.is_empty(), self.mode) {
-                (true, Mode::Layered) => LAYERED_IOR.to_vec(),
-                (true, Mode::Glass) => GLASS_IOR.to_vec(),
+                (true, Mode::Layered | Mode::Glass) => IOR_SWEEP.to_vec(),
                 _ => self.ior.clone(),
             },
             anisotropy: match (self.anisotropy.is_empty(), self.mode) {

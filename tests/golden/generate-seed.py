@@ -2456,9 +2456,10 @@ def glass_image(glass, node, side):
 
 def above_critical(chain, cell, table, mu, n):
     """The cell of a two-closure table's refraction lobe above the critical
-    angle (the glass's T leaving), whose rows are over u = sqrt((mu - mu_c) / (1 - mu_c)), mu_c = sqrt(1 - 1 / n^2) the
-    cosine below which the back face reflects totally (gloffuse's
-    above_critical): `cell` (slice_cell) with its row and fraction for u."""
+    angle (the glass's T leaving), whose rows are over
+    u = sqrt((mu - mu_c) / (1 - mu_c)), mu_c = sqrt(1 - 1 / n^2) the cosine
+    below which the back face reflects totally (gloffuse's above_critical):
+    `cell` (slice_cell) with its row and fraction for u."""
     critical = chain.math("SQRT", "mu_c = sqrt(1 - 1/n^2)",
                           chain.math("SUBTRACT", "1 - 1/n^2", 1.0,
                                      chain.math("DIVIDE", "1/n^2", 1.0,

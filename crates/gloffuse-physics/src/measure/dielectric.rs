@@ -302,7 +302,9 @@ pub fn above_critical_coordinate(mu: f64, ior: f64) -> f64 {
 /// `E(μ, r, η)` of the Glass and Refraction nodes of one distribution and Blender version on
 /// a grid: μ and r on the given axes, η on the coat tables' index slices
 /// ([`coat::slice_iors`], 1 to [`coat::IOR_MAX`], even in `z = F0^¼`), entering (η = IOR)
-/// and leaving (η = 1/IOR). The one table builder for the LUT and the Blender groups.
+/// and leaving (η = 1/IOR). The table builder for the LUT and the Blender groups, with
+/// [`DielectricIntegrator::refraction_above_critical`] for the two-closure glass's leaving
+/// refraction lobe.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DielectricGrid {
     pub ior: [f64; coat::SLICES],
@@ -354,6 +356,40 @@ impl DielectricGrid {
 }
 
 impl DielectricIntegrator {
+    /// The Refraction lobe's albedo leaving a glass (η = 1/IOR) on [`above_critical`]'s
+    /// axis, `[i][k][j]`: at `us[i]` above the critical cosine of index slice k
+    /// ([`coat::slice_iors`]), roughness `roughness[j]`; rows of u run in parallel.
+    pub fn refraction_above_critical(
+        &self,
+        distribution: Distribution,
+        version: BlenderVersion,
+        us: &[Roughness],
+        roughness: &[Roughness],
+    ) -> Vec<Vec<Vec<f64>>> {
+        let ior = coat::slice_iors();
+        us.par_iter()
+            .map(|u| {
+                ior.iter()
+                    .map(|&n| {
+                        let mu = above_critical(u.get(), n).max(1e-3);
+                        roughness
+                            .iter()
+                            .map(|&r| {
+                                let lobe = Dielectric::new(
+                                    DielectricNode::Refraction,
+                                    distribution,
+                                    r,
+                                    version,
+                                );
+                                self.directional_albedo(&lobe, mu, 1.0 / n)
+                            })
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
     /// The grid of `distribution` (GGX or Beckmann) as Blender `version` renders it, over
     /// `mus` and `roughness`; rows of μ run in parallel and `progress` steps once per row.
     pub fn grid(

@@ -10,11 +10,10 @@ use crate::fit::{Coefficients, ColorSpace, Curve, Target, preset_for_masking};
 use crate::measure::anisotropic::AnisotropicAxes;
 use crate::measure::dielectric::Side;
 use crate::measure::{
-    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, Dielectric, DielectricIntegrator,
-    DielectricNode, Distribution, Engine, GlassForm, Masking, Roughness, above_critical, coat,
+    AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, DielectricIntegrator, DielectricNode,
+    Distribution, Engine, GlassForm, Masking, Roughness, coat,
 };
 use crate::progress::Quiet;
-use rayon::prelude::*;
 
 /// Which correction a shader group applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -206,7 +205,7 @@ impl AnisotropicTable {
 ///   slice), with the Fresnel F at the normal computed in the group. E itself changes
 ///   steeply at the critical angle, which a table over μ would blur. So does T on the
 ///   leaving side, so the glass reads it from `refraction_above_critical`, whose rows are
-///   over [`above_critical`]'s `u` (row i at `u = i/(size − 1)`, each slice its own
+///   over `u` ([`crate::measure::above_critical`]) (row i at `u = i/(size − 1)`, each slice its own
 ///   critical cosine), not μ. (The Refraction node keeps `refraction_leaving` over μ: for
 ///   it, T below the critical cosine is all there is.)
 #[derive(Clone, Debug, Serialize)]
@@ -273,7 +272,12 @@ impl GlassTable {
         let e = |node, side| packed(&|k, i, j| grid.e(node, side, k, i, j));
         let one_closure = GlassForm::of(from) == GlassForm::OneClosure;
         let above_critical = (!one_closure).then(|| {
-            let rows = refraction_above_critical(distribution, from, &grid.ior, &axis);
+            let rows = DielectricIntegrator::default().refraction_above_critical(
+                distribution,
+                from,
+                &axis,
+                &axis,
+            );
             packed(&|k, i, j| rows[i][k][j])
         });
         GlassTable {
@@ -296,37 +300,6 @@ impl GlassTable {
             reflection: (!one_closure).then(|| packed(&|_, i, j| grid.reflection(i, j))),
         }
     }
-}
-
-/// The two-closure refraction lobe's albedo leaving a glass, `[i][k][j]`: at `u_i` above
-/// slice k's critical cosine ([`above_critical`]), roughness `r_j`, η = 1/IOR_k.
-fn refraction_above_critical(
-    distribution: Distribution,
-    version: BlenderVersion,
-    ior: &[f64],
-    axis: &[Roughness],
-) -> Vec<Vec<Vec<f64>>> {
-    let q = DielectricIntegrator::default();
-    axis.par_iter()
-        .map(|u| {
-            ior.iter()
-                .map(|&n| {
-                    let mu = above_critical(u.get(), n).max(1e-3);
-                    axis.iter()
-                        .map(|&r| {
-                            let lobe = Dielectric::new(
-                                DielectricNode::Refraction,
-                                distribution,
-                                r,
-                                version,
-                            );
-                            q.directional_albedo(&lobe, mu, 1.0 / n)
-                        })
-                        .collect()
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// E(μ, r) on a grid (row i is μ = i/(height − 1), column j is r = j/(width − 1)) and
@@ -834,7 +807,7 @@ fn as_blender_enum<S: serde::Serializer>(d: &Distribution, s: S) -> Result<S::Ok
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::measure::critical_cosine;
+    use crate::measure::{Dielectric, critical_cosine};
 
     /// The two-closure table's refraction lobe above the critical angle sits above each
     /// slice's critical cosine (row 0 at it, the last at μ = 1); the leaving refraction

@@ -140,12 +140,9 @@ fn write_notes(s: &mut String, report: &VerifyReport) {
 
 /// The spheres' table, failures first: numbers, two thumbnails and the false-colour one.
 fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
-    // Layered mode compares the hand-made Mix Shader with the layered group.
-    let (plain, fixed) = match report.mode {
-        crate::generate::Mode::Layered => ("Mix Shader", "layered"),
-        crate::generate::Mode::Glass => ("Glass BSDF", "corrected"),
-        _ => ("uncorrected", "corrected"),
-    };
+    // Layered mode compares the hand-made Mix Shader with the layered group, glass mode
+    // Blender's Glass BSDF with the glass group.
+    let (plain, fixed) = words::sphere_names(report.mode);
     let ring = if report.mode.per_pixel() {
         "worst ring"
     } else {

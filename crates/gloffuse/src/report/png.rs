@@ -631,11 +631,7 @@ fn draw_distribution<DB: DrawingBackend>(
             .map(|&p| Circle::new(p, 4, c.stroke_width(2))),
     )?;
     chart.draw_series(corrected.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
-    let (uncorrected_name, corrected_name) = match mode {
-        Mode::Layered => ("Mix Shader", "layered"),
-        Mode::Glass => ("Glass BSDF", "corrected"),
-        _ => ("uncorrected", "corrected"),
-    };
+    let (uncorrected_name, corrected_name) = super::words::sphere_names(mode);
     let mut legend = vec![
         Legend::Heading(d.label().to_string(), c),
         Legend::Entry(Key::Hollow(c), format!("{uncorrected_name}, rendered")),

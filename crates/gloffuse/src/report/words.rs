@@ -36,6 +36,15 @@ pub fn headline(report: &VerifyReport) -> String {
     }
 }
 
+/// What a report calls a row's two spheres in `mode`: (the plain one, the corrected one).
+pub fn sphere_names(mode: Mode) -> (&'static str, &'static str) {
+    match mode {
+        Mode::Layered => ("Mix Shader", "layered"),
+        Mode::Glass => ("Glass BSDF", "corrected"),
+        _ => ("uncorrected", "corrected"),
+    }
+}
+
 /// What "target" means in this report: the value every corrected sphere is judged against.
 pub fn target(report: &VerifyReport) -> String {
     let white = report.color == [1.0; 3];

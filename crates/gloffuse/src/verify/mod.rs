@@ -64,12 +64,10 @@ pub fn block_roughness() -> Vec<Roughness> {
         .to_vec()
 }
 
-/// The layered sweep's indices of refraction: water, glass, and a dense flint.
-pub const LAYERED_IOR: [f64; 3] = [1.33, 1.5, 2.0];
-
-/// The glass sweep's indices of refraction: water, glass, and a dense flint. Not diamond's
-/// 2.4 by default: there a rough solid sphere's noise needs about 1,024 spp (`--ior 2.4`).
-pub const GLASS_IOR: [f64; 3] = [1.33, 1.5, 2.0];
+/// The layered and glass sweeps' indices of refraction: water, glass, and a dense flint.
+/// Not diamond's 2.4 by default: there a rough solid glass sphere's noise needs about
+/// 1,024 spp (`--ior 2.4`).
+pub const IOR_SWEEP: [f64; 3] = [1.33, 1.5, 2.0];
 
 /// The anisotropic sweep's anisotropies: a moderate and a strong stretch along the tangent,
 /// and a strong one across it (a negative anisotropy swaps the widths).
@@ -346,13 +344,6 @@ fn with_groups(
     distributions: Vec<Distribution>,
     version: BlenderVersion,
 ) -> Result<Vec<Distribution>, Error> {
-    let has_group = |d: Distribution| {
-        d != Distribution::AshikhminShirley
-            && match v.mode {
-                Mode::Anisotropic => version.renders_anisotropic(d),
-                _ => GlassTable::builds_groups_for(version),
-            }
-    };
     if v.mode == Mode::Glass && !GlassTable::builds_groups_for(version) {
         return Err(Error::input(
             Field::Mode,
@@ -367,6 +358,11 @@ fn with_groups(
     if !matches!(v.mode, Mode::Anisotropic | Mode::Glass) {
         return Ok(distributions);
     }
+    // Past the refusal above, every glass distribution but Ashikhmin–Shirley has a group.
+    let has_group = |d: Distribution| {
+        d != Distribution::AshikhminShirley
+            && (v.mode == Mode::Glass || version.renders_anisotropic(d))
+    };
     if let Some(&d) = v.distributions.iter().find(|&&d| !has_group(d)) {
         return Err(Error::input(
             Field::Distribution,

@@ -414,7 +414,7 @@ pub enum SphereSpec {
 #[derive(Clone, Debug, Serialize)]
 pub struct FurnaceSection {
     pub engine: Engine,
-    /// Whole spheres that see themselves, each at its own depth, and 64 bounces (glass
+    /// Whole spheres that see themselves, each at its own depth, and 1,024 bounces (glass
     /// mode: light crosses a glass sphere's surfaces many times).
     pub solid: bool,
     pub cell: u32,
