@@ -143,14 +143,18 @@ fn a_smooth_interface_and_a_matched_index_return_everything() {
     }
 }
 
-/// The two-closure glass's leaving axis: `u = 0` is the critical cosine, where Snell's law
-/// (sin θ = 1/IOR) and the Fresnel reaching 1 put it, `u = 1` is μ = 1, and the inverse
-/// inverts. Across it, the refraction lobe leaving a nearly smooth glass falls from most
-/// of the light to almost none within 0.02 of μ: what a table over μ (steps of 1/15)
-/// would blur and this axis resolves.
+/// The leaving refraction tables' axis: `s = ½` is the critical cosine, where Snell's law
+/// (sin θ = 1/IOR) and the Fresnel reaching 1 put it, `s = 0` is μ = 0 and `s = 1` is
+/// μ = 1, the grid points crowd quadratically toward it from both sides, and the inverse
+/// inverts. Across it, the refraction lobe leaving a nearly smooth glass falls from most of
+/// the light to almost none within 0.02 of μ: what a table even in μ (steps of 1/15) would
+/// blur. The other tables' axis is `μ = t^1.5`.
 #[test]
-fn the_leaving_axis_starts_at_the_critical_angle() {
-    use gloffuse::measure::{above_critical, above_critical_coordinate, critical_cosine};
+fn the_leaving_axis_crowds_at_the_critical_angle() {
+    use gloffuse::measure::{
+        critical_cosine, critical_crowded, critical_crowded_coordinate, grazing_crowded,
+        grazing_crowded_coordinate,
+    };
     for ior in [1.0, 1.1, 1.5, 2.4, 3.0] {
         let c = critical_cosine(ior);
         // Snell: the sine of the critical angle is 1/IOR.
@@ -161,14 +165,30 @@ fn the_leaving_axis_starts_at_the_critical_angle() {
         if ior > 1.0 {
             assert_eq!(fresnel::dielectric(c - 1e-6, 1.0 / ior), 1.0, "IOR {ior}");
             assert!(fresnel::dielectric(c + 1e-3, 1.0 / ior) < 1.0, "IOR {ior}");
+            assert!((critical_crowded(0.0, ior)).abs() < 1e-15);
+            // A step of 1/15 from the middle moves μ by 1/225 of the side's span.
+            let below = c - critical_crowded(0.5 - 1.0 / 30.0, ior);
+            assert!((below - c / 225.0).abs() < 1e-12, "IOR {ior}: {below}");
         }
-        assert!((above_critical(0.0, ior) - c).abs() < 1e-15);
-        assert!((above_critical(1.0, ior) - 1.0).abs() < 1e-15);
-        assert_eq!(above_critical_coordinate(0.5 * c, ior), 0.0);
-        for u in [0.0, 0.1, 0.5, 0.9, 1.0] {
-            let back = above_critical_coordinate(above_critical(u, ior), ior);
-            assert!((back - u).abs() < 1e-9, "IOR {ior} u {u}: {back}");
+        assert!((critical_crowded(0.5, ior) - c).abs() < 1e-15);
+        assert!((critical_crowded(1.0, ior) - 1.0).abs() < 1e-15);
+        let above = critical_crowded(0.5 + 1.0 / 30.0, ior) - c;
+        assert!(
+            (above - (1.0 - c) / 225.0).abs() < 1e-12,
+            "IOR {ior}: {above}"
+        );
+        for s in [0.0, 0.1, 0.3, 0.5, 0.6, 0.9, 1.0] {
+            let back = critical_crowded_coordinate(critical_crowded(s, ior), ior);
+            assert!(
+                (back - s).abs() < 1e-9 || (ior == 1.0 && s < 0.5),
+                "IOR {ior} s {s}: {back}"
+            );
         }
+    }
+    for t in [0.0_f64, 0.25, 0.5, 1.0] {
+        let mu = t * t.sqrt();
+        assert!((grazing_crowded(t) - mu).abs() < 1e-15, "t {t}");
+        assert!((grazing_crowded_coordinate(mu) - t).abs() < 1e-12, "t {t}");
     }
     let q = DielectricIntegrator::default();
     let c = critical_cosine(1.5);

@@ -186,13 +186,25 @@ const fn solid(
     }
 }
 
-/// A sphere's mean and its rings' means (μ ≥ 0.22, by fifths of μ).
+/// A sphere's mean and its rings' means (μ ≥ 0.22, by fifths of μ), and the rim's: the
+/// pixels at μ 0.05–0.22. Outside μ 0.05 (the outermost pixel of each row) a pixel centre
+/// lies within 0.0013 of the silhouette, inside the 0.005 by which the 32-sided UV sphere
+/// misses the round one, so what it sees depends on the mesh.
 struct Rendered {
     mean: f64,
     rings: Vec<f64>,
+    rim: f64,
 }
 
-/// Renders solid spheres (every face the shader, 64 bounces) in Blender `label` with the
+/// The view cosine of pixel (col, row) of a solid sphere when it is in the rim.
+fn rim_cosine(col: usize, row: usize) -> Option<f64> {
+    let x = (col as f64 + 0.5) / PX as f64 * 2.0 - 1.0;
+    let z = (row as f64 + 0.5) / PX as f64 * 2.0 - 1.0;
+    let mu = (1.0 - x * x - z * z).max(0.0).sqrt();
+    (view_cosine(col, row).is_none() && mu >= 0.05).then_some(mu)
+}
+
+/// Renders solid spheres (every face the shader, 1,024 bounces) in Blender `label` with the
 /// groups of a `generate --mode glass` script built there, or none when that Blender is
 /// skipped.
 fn solid_spheres(label: &str, cases: &[Solid], samples: u32) -> Option<Vec<Rendered>> {
@@ -243,7 +255,12 @@ fn solid_spheres(label: &str, cases: &[Solid], samples: u32) -> Option<Vec<Rende
                 }
                 let total: f64 = rings.iter().map(|r| r.0).sum();
                 let count: usize = rings.iter().map(|r| r.1).sum();
+                let rim: Vec<f64> = (0..PX * PX)
+                    .filter(|&p| rim_cosine(p % PX, p / PX).is_some())
+                    .map(|p| pixels[p])
+                    .collect();
                 Rendered {
+                    rim: rim.iter().sum::<f64>() / rim.len() as f64,
                     mean: total / count as f64,
                     rings: rings
                         .iter()
@@ -322,14 +339,17 @@ const BLENDERS_OWN: [Solid; 2] = [
     solid(None, DielectricNode::Glass, "MULTI_GGX", 0.7, 1.5),
 ];
 
-/// What a group's solid sphere must do in Blender `label`: (mean, every ring) within these
-/// of 100 %. The goal is 2 % and 3 %; Blender 3.4 misses it with Beckmann, whose sampler
-/// returns up to 1.3 % more than its lobes at each interface (2.3 % for the sphere at r 0.9,
-/// IOR 1.8; docs/RESULTS.md).
-fn solid_tolerance(label: &str, c: &Solid) -> (f64, f64) {
-    match (label, c.distribution) {
-        ("3.4", "BECKMANN") => (0.035, 0.035),
-        _ => (0.02, 0.03),
+/// What a group's solid sphere must do in Blender `label`: (mean, every ring, the rim)
+/// within these of 100 %. The goal is 2 %, 3 % and 3 %. Blender 3.4 misses it with
+/// Beckmann, whose sampler returns up to 1.3 % more than its lobes at each interface (2.3 %
+/// for the sphere at r 0.9, IOR 1.8; docs/RESULTS.md), and at the rim of its Refraction
+/// group (GGX r 0.5, IOR 1.33: 96.63 % at 512 spp, where 4.5.15 and 5.0.1 give 99.3–99.6 %;
+/// not explained yet).
+fn solid_tolerance(label: &str, c: &Solid) -> (f64, f64, f64) {
+    match (label, c.distribution, c.node) {
+        ("3.4", "BECKMANN", _) => (0.035, 0.035, 0.035),
+        ("3.4", _, DielectricNode::Refraction) => (0.02, 0.03, 0.04),
+        _ => (0.02, 0.03, 0.03),
     }
 }
 
@@ -364,7 +384,7 @@ fn check_solid(label: &str) {
         let lo = r.rings.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = r.rings.iter().copied().fold(0.0, f64::max);
         let what = format!(
-            "Blender {label} {}{} {:?} {} r {} IOR {}: mean {:.2} %, rings {:.2}–{:.2} %",
+            "Blender {label} {}{} {:?} {} r {} IOR {}: mean {:.2} %, rings {:.2}–{:.2} %, rim {:.2} %",
             c.group.unwrap_or("plain"),
             if c.bump { " bumped" } else { "" },
             c.node,
@@ -373,21 +393,25 @@ fn check_solid(label: &str) {
             c.ior,
             100.0 * r.mean,
             100.0 * lo,
-            100.0 * hi
+            100.0 * hi,
+            100.0 * r.rim
         );
         println!("{what}");
         let judged = match (c.bump, c.group, c.distribution) {
             (true, ..) => true, // judged as a pair below
             (false, Some(_), _) => {
-                let (m, ring) = solid_tolerance(label, c);
-                (r.mean - 1.0).abs() <= m && (lo - 1.0).abs() <= ring && (hi - 1.0).abs() <= ring
+                let (m, ring, rim) = solid_tolerance(label, c);
+                (r.mean - 1.0).abs() <= m
+                    && (lo - 1.0).abs() <= ring
+                    && (hi - 1.0).abs() <= ring
+                    && (r.rim - 1.0).abs() <= rim
             }
             // Blender's single-scatter glass loses a third of the light.
             (false, None, "GGX") => r.mean < 0.7,
             // Multiscatter GGX glass: 3.4's random walk keeps everything; 4.5's and
-            // 5.0's tables leave the rim a few per cent dark.
+            // 5.0's tables leave the rim a few per cent dark (measured 93.8–93.9 %).
             (false, None, _) if label == "3.4" => (r.mean - 1.0).abs() < 0.005,
-            (false, None, _) => r.mean < 0.99 && lo < 0.97,
+            (false, None, _) => r.mean < 0.99 && lo < 0.97 && r.rim < 0.96,
         };
         if !judged {
             misses.push(what);

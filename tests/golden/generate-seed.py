@@ -2415,9 +2415,12 @@ COAT_DESCRIPTIONS = {
 # reads both sides at (mu, r, IOR) and takes the one its face needs (Geometry
 # > Backfacing). In 3.0-3.5 the Glass node's E is F R + max(1e-4, 1 - F) T
 # with the Fresnel F at the normal (a Fresnel node, exact where it jumps at
-# the critical angle) and the lobes' R and T from the tables; T falls as
-# steeply there when leaving, so the glass reads it leaving from a table over
-# u, the view cosine above the critical one (mu = mu_c + (1 - mu_c) u^2).
+# the critical angle) and the lobes' R and T from the tables. The tables'
+# rows are over t = mu^(2/3), crowded at grazing where E falls about as
+# sqrt(mu); the leaving refraction lobe's are over s, crowded from both sides
+# at the critical cosine mu_c = sqrt(1 - 1 / n^2), where that lobe falls
+# from most of the light to almost none (gloffuse's critical_crowded):
+# mu = mu_c + (1 - mu_c) (2s - 1)^2 above it, mu_c - mu_c (1 - 2s)^2 below.
 # mu comes from the shading-normal group (normal_group.py).
 #
 # A module of the gloffuse_blender package. Functions and constants only.
@@ -2447,28 +2450,34 @@ def glass_sockets(glass):
 
 def glass_image(glass, node, side):
     """The packed float image of E for `node` ("glass" or "refraction") and
-    `side` ("entering", "leaving", or for the two-closure glass's refraction
-    lobe leaving "above_critical")."""
+    `side` ("entering" or "leaving"; the two-closure glass's reflection lobe
+    is two_closure_albedo's)."""
     key = "%s_%s" % (node, side)
     return slice_image(glass["table"], key, "%s %s %s" % (glass["image"], node, side),
                        "glass.table")
 
 
-def above_critical(chain, cell, table, mu, n):
-    """The cell of a two-closure table's refraction lobe above the critical
-    angle (the glass's T leaving), whose rows are over
-    u = sqrt((mu - mu_c) / (1 - mu_c)), mu_c = sqrt(1 - 1 / n^2) the cosine
-    below which the back face reflects totally (gloffuse's above_critical):
-    `cell` (slice_cell) with its row and fraction for u."""
+def around_critical(chain, cell, table, mu, n):
+    """The cell of the leaving refraction table, whose rows are over s about
+    the critical cosine mu_c = sqrt(1 - 1 / n^2): s = 1/2 + d / 2 above it and
+    1/2 - d / 2 below, d = sqrt(|mu - mu_c| / (1 - mu_c or mu_c)) (gloffuse's
+    critical_crowded): `cell` (slice_cell) with its row and fraction for s."""
     critical = chain.math("SQRT", "mu_c = sqrt(1 - 1/n^2)",
                           chain.math("SUBTRACT", "1 - 1/n^2", 1.0,
                                      chain.math("DIVIDE", "1/n^2", 1.0,
                                                 chain.math("MULTIPLY", "n^2", n, n))))
-    above = chain.math("DIVIDE", "(mu - mu_c) / (1 - mu_c)",
-                       chain.math("SUBTRACT", "mu - mu_c", mu, critical),
-                       chain.math("SUBTRACT", "1 - mu_c", 1.0, critical))
-    u = chain.math("SQRT", "u = sqrt(clamp(...))", chain.clamp("clamp to [0, 1]", above, 0.0, 1.0))
-    row, up = grid_cell(chain, u, int(table["size"]), "u")
+    above = chain.math("GREATER_THAN", "above = mu > mu_c", mu, critical)
+    # The side's span: 1 - mu_c above, mu_c below (a Math node divides by 0 to 0).
+    span = chain.math("MULTIPLY_ADD", "span = mu_c + above (1 - 2 mu_c)", above,
+                      chain.math("MULTIPLY_ADD", "1 - 2 mu_c", critical, -2.0, 1.0), critical)
+    offset = chain.math("SUBTRACT", "mu - mu_c", mu, critical)
+    d = chain.math("SQRT", "d = sqrt(|mu - mu_c| / span)",
+                   chain.math("DIVIDE", "|mu - mu_c| / span",
+                              chain.math("ABSOLUTE", "|mu - mu_c|", offset), span))
+    s = chain.math("MULTIPLY_ADD", "s = 1/2 + sign(mu - mu_c) d / 2",
+                   chain.math("SIGN", "sign(mu - mu_c)", offset),
+                   chain.math("MULTIPLY", "d / 2", d, 0.5), 0.5)
+    row, up = grid_cell(chain, s, int(table["size"]), "s")
     first, second, _, across, _, t = cell
     return first, second, row, across, up, t
 
@@ -2516,15 +2525,15 @@ def build_glass_group(spec, params, node):
     chain = Chain(tree, frame, column=2, y=0.0)
     table = glass["table"]
     n = clamped_ior(table, chain, group_in.outputs["IOR"])
-    cell, _ = slice_cell(table, chain, r, mu, n)
+    cell, _ = slice_cell(table, chain, r, chain.math("POWER", "t = mu^(2/3)", mu, 2.0 / 3.0), n)
     two_closures = node == "glass" and table.get("form") == "two-closures"
-    entering = slice_read(chain, glass_image(glass, "refraction" if two_closures else node,
-                                             "entering"), cell, "E entering")
-    if two_closures:
-        leaving = slice_read(chain, glass_image(glass, "refraction", "above_critical"),
-                             above_critical(chain, cell, table, mu, n), "E leaving")
+    lobe = "refraction" if two_closures else node
+    entering = slice_read(chain, glass_image(glass, lobe, "entering"), cell, "E entering")
+    if lobe == "refraction":
+        leaving = slice_read(chain, glass_image(glass, lobe, "leaving"),
+                             around_critical(chain, cell, table, mu, n), "E leaving")
     else:
-        leaving = slice_read(chain, glass_image(glass, node, "leaving"), cell, "E leaving")
+        leaving = slice_read(chain, glass_image(glass, lobe, "leaving"), cell, "E leaving")
     albedo = chain.mix_value("E = the back face's (leaving) or the front's (entering)",
                              geometry.outputs["Backfacing"], entering, leaving)
     if two_closures:

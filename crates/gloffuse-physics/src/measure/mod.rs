@@ -21,8 +21,8 @@ pub mod version;
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
 pub use anisotropic::{AnisotropicIntegrator, AnisotropicLobe, Anisotropy};
 pub use dielectric::{
-    Dielectric, DielectricIntegrator, DielectricNode, GlassForm, above_critical,
-    above_critical_coordinate, critical_cosine,
+    Dielectric, DielectricIntegrator, DielectricNode, GlassForm, critical_cosine, critical_crowded,
+    critical_crowded_coordinate, grazing_crowded, grazing_crowded_coordinate,
 };
 pub use engine::Engine;
 pub use glossy::Glossy;

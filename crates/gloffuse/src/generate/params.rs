@@ -11,7 +11,7 @@ use crate::measure::anisotropic::AnisotropicAxes;
 use crate::measure::dielectric::Side;
 use crate::measure::{
     AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, DielectricIntegrator, DielectricNode,
-    Distribution, Engine, GlassForm, Masking, Roughness, coat,
+    Distribution, Engine, GlassForm, Masking, Roughness, coat, grazing_crowded,
 };
 use crate::progress::Quiet;
 
@@ -123,7 +123,10 @@ impl CoatTable {
     pub fn compute(distribution: Distribution, masking: Masking, size: usize) -> Self {
         let integrator = AlbedoIntegrator::default();
         let axis = Roughness::grid(size);
-        let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
+        let mus: Vec<f64> = axis
+            .iter()
+            .map(|t| grazing_crowded(t.get()).max(1e-3))
+            .collect();
         let grid = integrator.coat_grid(distribution, masking, &axis, &mus, &Quiet);
         let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
             let mut values = Vec::with_capacity(size * size * coat::SLICES);
@@ -195,19 +198,18 @@ impl AnisotropicTable {
 }
 
 /// `E(μ, r, η)` of the glass groups, in the layout of [`CoatTable`] (slices over the index,
-/// row i at μ = i/(size − 1), column j at r = j/(size − 1)), light entering (η = IOR) and
-/// leaving (η = 1/IOR), as the Blenders from `from_version` on within a masking family
-/// render them (the height-correlated family's Blender 3.5 still has 3.0–3.4's glass: it gets
-/// no glass groups). The Refraction node's E is in `refraction_*`. The Glass node's:
+/// column j at r = j/(size − 1)), light entering (η = IOR) and leaving (η = 1/IOR), as the
+/// Blenders from `from_version` on within a masking family render them (the
+/// height-correlated family's Blender 3.5 still has 3.0–3.4's glass: it gets no glass
+/// groups). Row i is at `t = i/(size − 1)` of [`crate::measure::grazing_crowded`] (μ = t^1.5),
+/// except in `refraction_leaving`, whose rows are at `s = i/(size − 1)` of
+/// [`crate::measure::critical_crowded`] (each slice about its own critical cosine, where
+/// that lobe falls steeply). The Refraction node's E is in `refraction_*`. The Glass node's:
 /// - one closure (3.6 on): `glass_*`, E itself;
 /// - two closures (3.0–3.5): `E = F(μ) R + max(1e-4, 1 − F(μ)) T`, T the refraction
 ///   lobe's (`refraction_*`) and R the reflection lobe's (`reflection`, the same in every
-///   slice), with the Fresnel F at the normal computed in the group. E itself changes
-///   steeply at the critical angle, which a table over μ would blur. So does T on the
-///   leaving side, so the glass reads it from `refraction_above_critical`, whose rows are
-///   over `u` ([`crate::measure::above_critical`]) (row i at `u = i/(size − 1)`, each slice its own
-///   critical cosine), not μ. (The Refraction node keeps `refraction_leaving` over μ: for
-///   it, T below the critical cosine is all there is.)
+///   slice), with the Fresnel F at the normal computed in the group: E itself jumps at the
+///   critical angle, which a table would blur.
 #[derive(Clone, Debug, Serialize)]
 pub struct GlassTable {
     pub size: usize,
@@ -230,11 +232,9 @@ pub struct GlassTable {
     pub glass_leaving: Option<Vec<f32>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reflection: Option<Vec<f32>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub refraction_above_critical: Option<Vec<f32>>,
 }
 
-/// Grid points per axis (μ, r) of each index slice of the glass groups' tables.
+/// Grid points per axis (view cosine, r) of each index slice of the glass groups' tables.
 pub const GLASS_TABLE_SIZE: usize = 16;
 
 impl GlassTable {
@@ -258,7 +258,10 @@ impl GlassTable {
         let from = Self::first_version(masking);
         let size = GLASS_TABLE_SIZE;
         let axis = Roughness::grid(size);
-        let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
+        let mus: Vec<f64> = axis
+            .iter()
+            .map(|t| grazing_crowded(t.get()).max(1e-3))
+            .collect();
         let grid = DielectricIntegrator::default().grid(distribution, from, &mus, &axis, &Quiet);
         let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
             let mut values = Vec::with_capacity(size * size * coat::SLICES);
@@ -271,15 +274,8 @@ impl GlassTable {
         };
         let e = |node, side| packed(&|k, i, j| grid.e(node, side, k, i, j));
         let one_closure = GlassForm::of(from) == GlassForm::OneClosure;
-        let above_critical = (!one_closure).then(|| {
-            let rows = DielectricIntegrator::default().refraction_above_critical(
-                distribution,
-                from,
-                &axis,
-                &axis,
-            );
-            packed(&|k, i, j| rows[i][k][j])
-        });
+        let leaving =
+            DielectricIntegrator::default().refraction_leaving(distribution, from, &axis, &axis);
         GlassTable {
             size,
             slices: coat::SLICES,
@@ -293,8 +289,7 @@ impl GlassTable {
                 "two-closures"
             },
             refraction_entering: e(DielectricNode::Refraction, Side::Entering),
-            refraction_leaving: e(DielectricNode::Refraction, Side::Leaving),
-            refraction_above_critical: above_critical,
+            refraction_leaving: packed(&|k, i, j| leaving[i][k][j]),
             glass_entering: one_closure.then(|| e(DielectricNode::Glass, Side::Entering)),
             glass_leaving: one_closure.then(|| e(DielectricNode::Glass, Side::Leaving)),
             reflection: (!one_closure).then(|| packed(&|_, i, j| grid.reflection(i, j))),
@@ -809,11 +804,12 @@ mod tests {
     use super::*;
     use crate::measure::{Dielectric, critical_cosine};
 
-    /// The two-closure table's refraction lobe above the critical angle sits above each
-    /// slice's critical cosine (row 0 at it, the last at μ = 1); the leaving refraction
-    /// rows of both forms are over μ.
+    /// Each table's texels are the integrator's E at their row's view cosine: μ = t^1.5 in
+    /// every table but the leaving Refraction one, whose rows crowd about each slice's
+    /// critical cosine (at it halfway up, at 0 and 1 in the first and last rows). Checked
+    /// against the axes' closed forms, not the axis functions the table is built with.
     #[test]
-    fn the_two_closure_leaving_rows_start_at_the_critical_angle() {
+    fn the_rows_crowd_at_grazing_and_at_the_critical_angle() {
         let q = DielectricIntegrator::default();
         let n = GLASS_TABLE_SIZE;
         for (masking, version) in [
@@ -821,31 +817,46 @@ mod tests {
             (Masking::HeightCorrelated, GlassForm::ONE_CLOSURE_FROM),
         ] {
             let table = GlassTable::compute(Distribution::Ggx, masking);
-            let tables = [(Some(&table.refraction_leaving), false)]
-                .into_iter()
-                .chain([(table.refraction_above_critical.as_ref(), true)]);
-            assert_eq!(
-                table.refraction_above_critical.is_some(),
-                masking == Masking::Separable
+            let cases = [
+                (&table.refraction_leaving, DielectricNode::Refraction, true),
+                (
+                    &table.refraction_entering,
+                    DielectricNode::Refraction,
+                    false,
+                ),
+            ]
+            .into_iter()
+            .chain(
+                table
+                    .glass_leaving
+                    .as_ref()
+                    .map(|v| (v, DielectricNode::Glass, true)),
             );
-            for ((values, above), (i, k, j)) in tables
-                .filter_map(|(v, above)| Some((v?, above)))
-                .flat_map(|t| [(t, (0, 6, 2)), (t, (3, 11, 15)), (t, (15, 4, 8))])
-            {
+            for ((values, node, leaving), (i, k, j)) in cases.flat_map(|c| {
+                [
+                    (c, (0, 6, 2)),
+                    (c, (3, 11, 15)),
+                    (c, (9, 4, 8)),
+                    (c, (15, 7, 1)),
+                ]
+            }) {
                 let (ior, x) = (table.ior[k], i as f64 / (n - 1) as f64);
-                let mu = if above {
-                    critical_cosine(ior) + (1.0 - critical_cosine(ior)) * x * x
-                } else {
-                    x
+                let c = critical_cosine(ior);
+                let mu = match (node, leaving) {
+                    (DielectricNode::Refraction, true) if x >= 0.5 => {
+                        c + (1.0 - c) * (2.0 * x - 1.0).powi(2)
+                    }
+                    (DielectricNode::Refraction, true) => c * (1.0 - (1.0 - 2.0 * x).powi(2)),
+                    _ => x * x.sqrt(),
                 };
                 let r = Roughness::new(j as f64 / (n - 1) as f64).unwrap();
-                let lobe =
-                    Dielectric::new(DielectricNode::Refraction, Distribution::Ggx, r, version);
-                let want = q.directional_albedo(&lobe, mu.max(1e-3), 1.0 / ior) as f32;
+                let lobe = Dielectric::new(node, Distribution::Ggx, r, version);
+                let eta = if leaving { 1.0 / ior } else { ior };
+                let want = q.directional_albedo(&lobe, mu.max(1e-3), eta) as f32;
                 let got = values[(i * table.slices + k) * n + j];
                 assert!(
                     (got - want).abs() < 1e-6,
-                    "{masking:?} ({i}, {k}, {j}): {got} vs {want}"
+                    "{masking:?} {node:?} leaving {leaving} ({i}, {k}, {j}): {got} vs {want}"
                 );
             }
         }
