@@ -123,10 +123,7 @@ impl CoatTable {
     pub fn compute(distribution: Distribution, masking: Masking, size: usize) -> Self {
         let integrator = AlbedoIntegrator::default();
         let axis = Roughness::grid(size);
-        let mus: Vec<f64> = axis
-            .iter()
-            .map(|t| grazing_crowded(t.get()).max(1e-3))
-            .collect();
+        let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
         let grid = integrator.coat_grid(distribution, masking, &axis, &mus, &Quiet);
         let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
             let mut values = Vec::with_capacity(size * size * coat::SLICES);
