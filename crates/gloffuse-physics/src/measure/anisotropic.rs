@@ -321,10 +321,12 @@ impl AnisotropicIntegrator {
         total
     }
 
-    /// `E(μ_i, φ_k, αx = rx_j², αy = ry_l²)` and `E_avg(rx_j², ry_l²)` on a grid: the one
-    /// table builder for the LUT and the Blender groups. Slices of one `ry` run in parallel
-    /// and `progress` steps once per slice; every entry is computed independently, so the
-    /// table is identical for any thread count.
+    /// `E(μ_i, φ_k, αx = rx_j², αy = ry_l²)` on a grid: the one table builder for the LUT
+    /// and the Blender groups. Slices of one `ry` run in parallel and `progress` steps once
+    /// per slice; every entry is computed independently, so the table is identical for any
+    /// thread count. On square axes (`rx` = `ry`, azimuths mirrored about π/4) half the
+    /// entries come from the other half by [`swapped`]: turning the frame a quarter turn
+    /// swaps the widths and takes the view's azimuth φ to π/2 − φ.
     pub fn grid(
         &self,
         distribution: Distribution,
@@ -332,39 +334,95 @@ impl AnisotropicIntegrator {
         axes: AnisotropicAxes,
         progress: &dyn Progress,
     ) -> Result<AnisotropicGrid, Error> {
-        let lobes: Vec<Vec<AnisotropicLobe>> = axes
-            .ry
-            .iter()
-            .map(|&ry| {
-                axes.rx
-                    .iter()
-                    .map(|&rx| AnisotropicLobe::new(distribution, masking, rx * rx, ry * ry))
-                    .collect()
-            })
-            .collect::<Result<_, _>>()?;
-        let slices: Vec<(Vec<f64>, Vec<f64>)> = lobes
+        let lobes = lobe_rows(distribution, masking, &axes.rx, &axes.ry)?;
+        let square = axes.is_square();
+        let slices: Vec<Vec<f64>> = lobes
             .par_iter()
-            .map(|row| {
+            .enumerate()
+            .map(|(l, row)| {
+                // On square axes, slice l computes the widths rx_j ≤ ry_l only.
+                let row = if square { &row[..=l] } else { &row[..] };
                 let mut e = Vec::with_capacity(row.len() * axes.phi.len() * axes.mu.len());
                 for &mu in &axes.mu {
                     for &phi in &axes.phi {
-                        for lobe in row {
-                            e.push(self.directional_albedo(lobe, view(mu, phi)));
-                        }
+                        e.extend(
+                            row.iter()
+                                .map(|lobe| self.directional_albedo(lobe, view(mu, phi))),
+                        );
                     }
                 }
-                let e_avg = row.iter().map(|lobe| self.average_albedo(lobe)).collect();
                 progress.step();
-                (e, e_avg)
+                e
             })
             .collect();
-        let (e, e_avg) = slices.into_iter().unzip::<_, _, Vec<_>, Vec<_>>();
-        Ok(AnisotropicGrid {
-            axes,
-            e: e.concat(),
-            e_avg: e_avg.concat(),
-        })
+        let (n_mu, n_phi, n_rx) = (axes.mu.len(), axes.phi.len(), axes.rx.len());
+        let computed = |i: usize, k: usize, j: usize, l: usize| {
+            let width = if square { l + 1 } else { n_rx };
+            slices[l][(i * n_phi + k) * width + j]
+        };
+        let mut e = Vec::with_capacity(axes.ry.len() * n_mu * n_phi * n_rx);
+        for l in 0..axes.ry.len() {
+            for i in 0..n_mu {
+                for k in 0..n_phi {
+                    e.extend((0..n_rx).map(|j| {
+                        if square && j > l {
+                            let (k, j, l) = swapped(k, j, l, n_phi);
+                            computed(i, k, j, l)
+                        } else {
+                            computed(i, k, j, l)
+                        }
+                    }));
+                }
+            }
+        }
+        Ok(AnisotropicGrid { axes, e })
     }
+
+    /// `E_avg(rx_j², ry_l²)` per pair of widths, `[l · |rx| + j]`: the hemispherical average
+    /// of [`Self::average_albedo`] (symmetric in the two widths). Rows of one `ry` run in
+    /// parallel and `progress` steps once per row.
+    pub fn average_grid(
+        &self,
+        distribution: Distribution,
+        masking: Masking,
+        rx: &[f64],
+        ry: &[f64],
+        progress: &dyn Progress,
+    ) -> Result<Vec<f64>, Error> {
+        let lobes = lobe_rows(distribution, masking, rx, ry)?;
+        let rows: Vec<Vec<f64>> = lobes
+            .par_iter()
+            .map(|row| {
+                let averages = row.iter().map(|lobe| self.average_albedo(lobe)).collect();
+                progress.step();
+                averages
+            })
+            .collect();
+        Ok(rows.concat())
+    }
+}
+
+/// The lobes of a grid: `rows[l][j]` has `αx = rx_j²`, `αy = ry_l²`.
+fn lobe_rows(
+    distribution: Distribution,
+    masking: Masking,
+    rx: &[f64],
+    ry: &[f64],
+) -> Result<Vec<Vec<AnisotropicLobe>>, Error> {
+    ry.iter()
+        .map(|&ry| {
+            rx.iter()
+                .map(|&rx| AnisotropicLobe::new(distribution, masking, rx * rx, ry * ry))
+                .collect()
+        })
+        .collect()
+}
+
+/// The grid entry (azimuth k, widths j, l) that equals entry (k, l, j) with the widths
+/// swapped: a quarter turn of the frame takes φ_k to π/2 − φ_k = φ_{n−1−k} on mirrored
+/// azimuths.
+fn swapped(k: usize, j: usize, l: usize, azimuths: usize) -> (usize, usize, usize) {
+    (azimuths - 1 - k, l, j)
 }
 
 /// Hemispherical averages use this many Gauss nodes along μ (half as many along φ).
@@ -382,6 +440,14 @@ pub struct AnisotropicAxes {
 }
 
 impl AnisotropicAxes {
+    /// Whether the two width axes are the same and the azimuths mirror about π/4 (φ_k +
+    /// φ_{n−1−k} = π/2): then [`AnisotropicIntegrator::grid`] computes half the table.
+    pub fn is_square(&self) -> bool {
+        let n = self.phi.len();
+        self.rx == self.ry
+            && (0..n).all(|k| (self.phi[k] + self.phi[n - 1 - k] - FRAC_PI_2).abs() < 1e-12)
+    }
+
     /// The axes of a table to interpolate in (the LUT and the Blender groups): `n` grid
     /// points from 0 to 1 on N·V, `√αx` and `√αy`, and `azimuths` from 0 to π/2. Grid
     /// points, not pixel centres, so both ends are exact: one width is often clamped to 1,
@@ -406,15 +472,12 @@ impl AnisotropicAxes {
     }
 }
 
-/// `E` on [`AnisotropicAxes`] and `E_avg` per pair of widths, from
-/// [`AnisotropicIntegrator::grid`].
+/// `E` on [`AnisotropicAxes`], from [`AnisotropicIntegrator::grid`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct AnisotropicGrid {
     pub axes: AnisotropicAxes,
     /// `e[((l · |μ| + i) · |φ| + k) · |rx| + j] = E(μ_i, φ_k, rx_j, ry_l)`.
     pub e: Vec<f64>,
-    /// `e_avg[l · |rx| + j] = E_avg(rx_j, ry_l)`.
-    pub e_avg: Vec<f64>,
 }
 
 impl AnisotropicGrid {
@@ -422,11 +485,6 @@ impl AnisotropicGrid {
     pub fn e(&self, i: usize, k: usize, j: usize, l: usize) -> f64 {
         let a = &self.axes;
         self.e[((l * a.mu.len() + i) * a.phi.len() + k) * a.rx.len() + j]
-    }
-
-    /// `E_avg(rx_j, ry_l)`.
-    pub fn e_avg(&self, j: usize, l: usize) -> f64 {
-        self.e_avg[l * self.axes.rx.len() + j]
     }
 }
 

@@ -31,7 +31,8 @@ pub fn azimuths() -> Vec<f64> {
 }
 
 /// The anisotropic atlas of `distribution` (GGX or Beckmann, checked by the caller) with
-/// `masking`, `size` texels per slice side; `progress` steps once per row of slices.
+/// `masking`, `size` texels per slice side; `progress` steps twice per row of slices (its averages,
+/// then its E).
 pub fn anisotropic_table(
     size: usize,
     distribution: Distribution,
@@ -39,7 +40,11 @@ pub fn anisotropic_table(
     progress: &dyn Progress,
 ) -> Table {
     let axes = AnisotropicAxes::table(size, AZIMUTHS);
-    let grid = AnisotropicIntegrator::default()
+    let integrator = AnisotropicIntegrator::default();
+    let e_avg = integrator
+        .average_grid(distribution, masking, &axes.rx, &axes.ry, progress)
+        .expect("grid points are widths within [0, 1] and the caller checked the distribution");
+    let grid = integrator
         .grid(distribution, masking, axes, progress)
         .expect("grid points are widths within [0, 1] and the caller checked the distribution");
     let mut data = Vec::with_capacity(size * size * AZIMUTHS * size * 2);
@@ -47,7 +52,10 @@ pub fn anisotropic_table(
         for i in 0..size {
             for k in 0..AZIMUTHS {
                 for j in 0..size {
-                    data.extend_from_slice(&[grid.e(i, k, j, l) as f32, grid.e_avg(j, l) as f32]);
+                    data.extend_from_slice(&[
+                        grid.e(i, k, j, l) as f32,
+                        e_avg[l * size + j] as f32,
+                    ]);
                 }
             }
         }

@@ -401,9 +401,8 @@ impl Spec {
             Spec::SplitSum { size, .. }
             | Spec::Albedo { size, .. }
             | Spec::Coat { size, .. }
-            | Spec::Anisotropic { size, .. }
             | Spec::Glass { size, .. } => size,
-            Spec::KullaConty { size, .. } => 2 * size,
+            Spec::KullaConty { size, .. } | Spec::Anisotropic { size, .. } => 2 * size,
         }
     }
 
