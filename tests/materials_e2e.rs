@@ -22,7 +22,8 @@
 //!
 //! And one lit scene (sky + sun, Noise → Bump, a coloured base, 4.5 and 5.0): `Gloffuse
 //! Layered (GGX)` against Principled BSDF, and `Gloffuse View (GGX)` against Multiscatter
-//! GGX, where the lobe's shape shows and not only its total.
+//! GGX, where the lobe's shape shows and not only its total; and a solid `Gloffuse Glass
+//! (GGX)` sphere in it against Multiscatter GGX glass.
 
 mod common;
 
@@ -582,6 +583,91 @@ fn coats_follow_their_references_in_a_lit_bumped_scene() {
             failures.is_empty(),
             "Blender {label}: {}",
             failures.join("; ")
+        );
+    }
+}
+
+fn glass(name: &str, group: Option<&str>, distribution: &str) -> Value {
+    json!({"name": name, "kind": "glass", "group": group, "distribution": distribution,
+        "color": [1.0, 1.0, 1.0], "ior": 1.5})
+}
+
+/// Rough glass in the lit scene (`lit_scene` with the sphere solid, so light refracted into
+/// it crosses its far side, and roughness 0.1 → 1 across it; IOR 1.5), against the
+/// energy-conserving answer Blender 4.5 and 5.0 have: Multiscatter GGX glass, which there is
+/// the single-scatter glass scaled by 1/E from Cycles' own E(μ, r, η) table, the form of
+/// `Gloffuse Glass (GGX)`. So the two may differ only as their E do: per channel on every
+/// 4 × 4 block the group is at most 1 % darker and at most 8 % brighter (measured: 1.1 % to
+/// 7.0 % brighter, most at the rim, where Multiscatter GGX glass is itself up to 10 % short in
+/// the furnace), 0–5 % brighter on average; and Blender's single-scatter GGX glass is more
+/// than 20 % darker on average, so the scene needs the compensation. Not in 3.4, whose
+/// Multiscatter GGX glass is a random walk with a lobe of its own (measured: 23 % darker
+/// to 9 % brighter per block).
+#[test]
+fn glass_follows_multiscatter_ggx_in_a_lit_bumped_scene() {
+    for (label, blender) in common::blender::real_blenders() {
+        if label == "3.4" {
+            eprintln!("Blender 3.4: skipped, its Multiscatter GGX glass is a random walk");
+            continue;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let variants = vec![
+            glass("group", Some("Gloffuse Glass (GGX)"), "GGX"),
+            glass("multiscatter", None, "MULTI_GGX"),
+            glass("single", None, "GGX"),
+        ];
+        let mut scene = lit_scene();
+        scene["solid"] = json!(true);
+        scene["roughness"] = json!([0.1, 1.0]);
+        let (_, images) = render(
+            &blender,
+            Engine::Cycles,
+            (ColorModel::Exact, &[Mode::Glass]),
+            scene,
+            variants,
+            dir.path(),
+        );
+        let reference = &images["multiscatter"];
+        let blocks = blocks(reference);
+        assert!(
+            blocks.len() > 40,
+            "Blender {label}: {} blocks",
+            blocks.len()
+        );
+        // Per block and channel: group / Multiscatter, and the mean over blocks.
+        let ratios = |name: &str| -> Vec<f64> {
+            let image = &images[name];
+            blocks
+                .iter()
+                .flat_map(|pixels| {
+                    (0..3).map(move |c| {
+                        let sum =
+                            |im: &Rgba| pixels.iter().map(|&i| channel(im, i, c)).sum::<f64>();
+                        sum(image) / sum(reference)
+                    })
+                })
+                .collect()
+        };
+        let mean = |r: &[f64]| r.iter().sum::<f64>() / r.len() as f64;
+        let group = ratios("group");
+        let (low, high) = group.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
+            (lo.min(r), hi.max(r))
+        });
+        let single = mean(&ratios("single"));
+        eprintln!(
+            "Blender {label}, lit glass, {} blocks: group / Multiscatter GGX glass {low:.4}–{high:.4} \
+             per block, {:.4} on average; single-scatter glass {single:.4} on average",
+            blocks.len(),
+            mean(&group)
+        );
+        assert!(
+            low >= 0.99 && high <= 1.08 && (1.0..=1.05).contains(&mean(&group)),
+            "Blender {label}: group / Multiscatter GGX glass {low:.4}–{high:.4} per block, {:.4} on average",
+            mean(&group)
+        );
+        assert!(
+            single < 0.8,
+            "Blender {label}: single-scatter glass at {single:.4}"
         );
     }
 }

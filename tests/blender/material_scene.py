@@ -15,7 +15,9 @@
 # ("lighting": "sky_sun": a sky graded from horizon to zenith plus a sun, as
 # {"sky": [horizon, zenith], "sun": {"strength", "angle", "elevation",
 # "azimuth"}}) and for a real Bump node instead of the tilted normal ("bump":
-# {"strength", "distance"}).
+# {"strength", "distance"}), and for a "solid" sphere (true): seen by every
+# kind of ray, so light refracted into it crosses its far side, with the
+# furnace's bounces for solid glass (for the "glass" variants).
 #
 # Variants ("kind"):
 #   glossy      a plain Glossy BSDF of "distribution" (MULTI_GGX included)
@@ -26,6 +28,9 @@
 #               "ior", "tint" as Specular Tint, Normal)
 #   principled  a Principled BSDF with the same inputs ("distribution",
 #               Multiscatter GGX by default)
+#   glass       the glass group "group" (Color, Roughness, IOR "ior", Normal) or,
+#               without "group", Blender's Glass BSDF of "distribution" with
+#               the same inputs
 #   metallic    a Metallic BSDF of "distribution" in Physical Conductor mode,
 #               IOR "ior" on every channel, Extinction 0
 #   probe       an emission of 0.5 + 0.5 v for v = the view direction ("incoming"),
@@ -169,6 +174,18 @@ def variant_material(scene, variant):
         node.inputs["Specular Tint"].default_value = tuple(variant.get("tint", (1.0,) * 3)) + (1.0,)
         links.new(roughness, node.inputs["Roughness"])
         links.new(normal, node.inputs["Normal"])
+    elif kind == "glass":
+        if variant.get("group"):
+            node = nodes.new("ShaderNodeGroup")
+            node.node_tree = bpy.data.node_groups[variant["group"]]
+        else:
+            node = nodes.new("ShaderNodeBsdfGlass")
+            node.distribution = variant["distribution"]
+        node.inputs["Color"].default_value = color
+        node.inputs["IOR"].default_value = variant["ior"]
+        links.new(roughness, node.inputs["Roughness"])
+        links.new(normal, node.inputs["Normal"])
+        shader = node.outputs[0]
     elif kind == "metallic":
         node = nodes.new("ShaderNodeBsdfMetallic")
         node.distribution = variant["distribution"]
@@ -238,7 +255,9 @@ def build_scene(scene):
     render_scene = bpy.context.scene
     size = scene["resolution"]
     engine = scene.get("engine", "cycles")
-    settings = {"engine": engine, "cell": size, "samples": scene["samples"], "seed": scene["seed"], "threads": 0}
+    solid = bool(scene.get("solid"))
+    settings = {"engine": engine, "cell": size, "samples": scene["samples"], "seed": scene["seed"],
+                "threads": 0, "solid": solid}
     # The world first: some of EEVEE's settings are the world's.
     lit = scene.get("lighting", "furnace") == "sky_sun"
     render_scene.world = sky_world(scene["sky"]) if lit else furnace_world()
@@ -263,7 +282,8 @@ def build_scene(scene):
     sphere = bpy.data.objects.new("Scene sphere", mesh)
     sphere.location = (0.45, 0.0, 0.25)
     render_scene.collection.objects.link(sphere)
-    compat_camera_rays_only(sphere)
+    if not solid:
+        compat_camera_rays_only(sphere)
     return render_scene, sphere
 
 
