@@ -13,6 +13,7 @@
 #[path = "shared/xorshift.rs"]
 mod xorshift;
 
+use gloffuse::generate::ColorModel;
 use gloffuse::generate::params::GlassTable;
 use gloffuse::measure::coat::slice_coordinate;
 use gloffuse::measure::{
@@ -33,7 +34,7 @@ fn main() {
     ] {
         let version: BlenderVersion = version.parse().unwrap();
         for d in [Distribution::Ggx, Distribution::Beckmann] {
-            let table = GlassTable::compute(d, masking);
+            let table = GlassTable::compute(d, masking, ColorModel::Exact);
             let n = table.size;
             let z_max = table.z_max;
             let lerp = |a: f64, b: f64, t: f64| a + t * (b - a);

@@ -275,7 +275,12 @@ def gained_bsdf(tree, group_in, gain, bsdf, x):
     """The end of a shader group that divides Blender's own BSDF's colour by
     its albedo: Color x Gain at x, into `bsdf`'s Color one column on, `bsdf`
     into the group's BSDF output one more on."""
-    color = apply_gain(tree, group_in.outputs["Color"], gain, (x, 0.0))
+    colored_bsdf(tree, apply_gain(tree, group_in.outputs["Color"], gain, (x, 0.0)), bsdf, x)
+
+
+def colored_bsdf(tree, color, bsdf, x):
+    """The end of a shader group: `color` into `bsdf`'s Color, `bsdf` one
+    column on from x, into the group's BSDF output one more on."""
     bsdf.width = NODE_WIDTH
     bsdf.location = (x + COLUMN_STEP, 0.0)
     tree.links.new(color, bsdf.inputs["Color"])

@@ -206,6 +206,17 @@ def tinted_energy(chain, color, e_avg):
                         chain.vector("SCALE", "C E_avg", color, e_avg), den)
 
 
+def physical_color(chain, color, albedo, e_avg):
+    """The physical colour model's colour C (1 + Fms (1 - E) / E): the energy
+    multiple bounces add, tinted (tinted_energy). The node is named "Apply gain"."""
+    fms = tinted_energy(chain, color, e_avg)
+    ratio = chain.math("DIVIDE", "(1 - E) / E", chain.math("SUBTRACT", "1 - E", 1.0, albedo), albedo)
+    factor = chain.vector("ADD", "1 + Fms (1 - E) / E", (1.0, 1.0, 1.0),
+                          chain.vector("SCALE", "Fms (1 - E) / E", fms, ratio))
+    return chain.vector("MULTIPLY", "Color (1 + Fms (1 - E) / E)", color, factor,
+                        name="Apply gain")
+
+
 def glossy_plus_diffuse(tree, spec, group_in, glossy_color, diffuse_color, x, labels):
     """Glossy BSDF (the spec's distribution; the group's Roughness and Normal) of
     colour glossy_color, plus a Diffuse BSDF of colour diffuse_color (the group's
@@ -266,13 +277,7 @@ def build_view_correction_group(spec, params):
     x_end = FRAME_INSET + COLUMN_STEP * (column + 1) + 150.0
     if physical:
         chain = Chain(tree, frame, column=column + 1, y=-ROW_STEP)
-        color = group_in.outputs["Color"]
-        fms = tinted_energy(chain, color, e_avg)
-        ratio = chain.math("DIVIDE", "(1 - E) / E", chain.math("SUBTRACT", "1 - E", 1.0, albedo), albedo)
-        factor = chain.vector("ADD", "1 + Fms (1 - E) / E", (1.0, 1.0, 1.0),
-                              chain.vector("SCALE", "Fms (1 - E) / E", fms, ratio))
-        color_out = chain.vector("MULTIPLY", "Color (1 + Fms (1 - E) / E)", color, factor,
-                                 name="Apply gain")
+        color_out = physical_color(chain, group_in.outputs["Color"], albedo, e_avg)
         x_end = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
     else:
         color_out = apply_gain(tree, group_in.outputs["Color"], gain.outputs[0], (x_end, 0.0))

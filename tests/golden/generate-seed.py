@@ -744,7 +744,12 @@ def gained_bsdf(tree, group_in, gain, bsdf, x):
     """The end of a shader group that divides Blender's own BSDF's colour by
     its albedo: Color x Gain at x, into `bsdf`'s Color one column on, `bsdf`
     into the group's BSDF output one more on."""
-    color = apply_gain(tree, group_in.outputs["Color"], gain, (x, 0.0))
+    colored_bsdf(tree, apply_gain(tree, group_in.outputs["Color"], gain, (x, 0.0)), bsdf, x)
+
+
+def colored_bsdf(tree, color, bsdf, x):
+    """The end of a shader group: `color` into `bsdf`'s Color, `bsdf` one
+    column on from x, into the group's BSDF output one more on."""
     bsdf.width = NODE_WIDTH
     bsdf.location = (x + COLUMN_STEP, 0.0)
     tree.links.new(color, bsdf.inputs["Color"])
@@ -1758,6 +1763,17 @@ def tinted_energy(chain, color, e_avg):
                         chain.vector("SCALE", "C E_avg", color, e_avg), den)
 
 
+def physical_color(chain, color, albedo, e_avg):
+    """The physical colour model's colour C (1 + Fms (1 - E) / E): the energy
+    multiple bounces add, tinted (tinted_energy). The node is named "Apply gain"."""
+    fms = tinted_energy(chain, color, e_avg)
+    ratio = chain.math("DIVIDE", "(1 - E) / E", chain.math("SUBTRACT", "1 - E", 1.0, albedo), albedo)
+    factor = chain.vector("ADD", "1 + Fms (1 - E) / E", (1.0, 1.0, 1.0),
+                          chain.vector("SCALE", "Fms (1 - E) / E", fms, ratio))
+    return chain.vector("MULTIPLY", "Color (1 + Fms (1 - E) / E)", color, factor,
+                        name="Apply gain")
+
+
 def glossy_plus_diffuse(tree, spec, group_in, glossy_color, diffuse_color, x, labels):
     """Glossy BSDF (the spec's distribution; the group's Roughness and Normal) of
     colour glossy_color, plus a Diffuse BSDF of colour diffuse_color (the group's
@@ -1818,13 +1834,7 @@ def build_view_correction_group(spec, params):
     x_end = FRAME_INSET + COLUMN_STEP * (column + 1) + 150.0
     if physical:
         chain = Chain(tree, frame, column=column + 1, y=-ROW_STEP)
-        color = group_in.outputs["Color"]
-        fms = tinted_energy(chain, color, e_avg)
-        ratio = chain.math("DIVIDE", "(1 - E) / E", chain.math("SUBTRACT", "1 - E", 1.0, albedo), albedo)
-        factor = chain.vector("ADD", "1 + Fms (1 - E) / E", (1.0, 1.0, 1.0),
-                              chain.vector("SCALE", "Fms (1 - E) / E", fms, ratio))
-        color_out = chain.vector("MULTIPLY", "Color (1 + Fms (1 - E) / E)", color, factor,
-                                 name="Apply gain")
+        color_out = physical_color(chain, group_in.outputs["Color"], albedo, e_avg)
         x_end = FRAME_INSET + COLUMN_STEP * (chain.column + 1) + 150.0
     else:
         color_out = apply_gain(tree, group_in.outputs["Color"], gain.outputs[0], (x_end, 0.0))
@@ -2423,6 +2433,13 @@ COAT_DESCRIPTIONS = {
 # mu = mu_c + (1 - mu_c) (2s - 1)^2 above it, mu_c - mu_c (1 - 2s)^2 below.
 # mu comes from the shading-normal group (normal_group.py).
 #
+# Colour (params["color_model"]): "exact" gives the node Color / E, so every
+# interface returns Color of what meets it; "physical" gives it
+# Color (1 + Fms (1 - E) / E) with Fms = C E_avg / (1 - C (1 - E_avg)) and
+# E_avg(r, eta) the side's average (tables laid out as E's, every row alike),
+# tinting the light the microfacets bounce more than once, as Blender 4.x's
+# Multiscatter GGX glass does with its Color. White glass is the same in both.
+#
 # A module of the gloffuse_blender package. Functions and constants only.
 # ---------------------------------------------------------------------------
 
@@ -2448,12 +2465,12 @@ def glass_sockets(glass):
     ]
 
 
-def glass_image(glass, node, side):
-    """The packed float image of E for `node` ("glass" or "refraction") and
-    `side` ("entering" or "leaving"; the two-closure glass's reflection lobe
-    is two_closure_albedo's)."""
-    key = "%s_%s" % (node, side)
-    return slice_image(glass["table"], key, "%s %s %s" % (glass["image"], node, side),
+def glass_image(glass, node, side, what=None):
+    """The packed float image of E (or with `what` "average", of E_avg) for
+    `node` ("glass" or "refraction") and `side` ("entering" or "leaving"; the
+    two-closure glass's reflection lobe is two_closure_albedo's)."""
+    key = "_".join(filter(None, (node, what, side)))
+    return slice_image(glass["table"], key, "%s %s" % (glass["image"], key.replace("_", " ")),
                        "glass.table")
 
 
@@ -2538,22 +2555,37 @@ def build_glass_group(spec, params, node):
                              geometry.outputs["Backfacing"], entering, leaving)
     if two_closures:
         albedo = two_closure_albedo(tree, chain, glass, group_in, cell, n, albedo, frame)
-    gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
     bsdf = nodes.new(kind)
     bsdf.name = label
     bsdf.distribution = spec["distribution"]
     links.new(group_in.outputs["Roughness"], bsdf.inputs["Roughness"])
     links.new(n, bsdf.inputs["IOR"])
     links.new(group_in.outputs["Normal"], bsdf.inputs["Normal"])
-    gained_bsdf(tree, group_in, gain, bsdf, FRAME_INSET + COLUMN_STEP * (chain.column + 2))
+    physical = params.get("color_model") == "physical"
+    if physical:
+        averages = [slice_read(chain, glass_image(glass, node, side, "average"), cell,
+                               "E_avg %s" % side)
+                    for side in ("entering", "leaving")]
+        e_avg = chain.mix_value("E_avg = the back face's (leaving) or the front's (entering)",
+                                geometry.outputs["Backfacing"], averages[0], averages[1])
+        color = physical_color(chain, group_in.outputs["Color"], albedo, e_avg)
+        colored_bsdf(tree, color, bsdf, FRAME_INSET + COLUMN_STEP * (chain.column + 2))
+    else:
+        gain = chain.math("DIVIDE", "Gain = 1 / E", 1.0, albedo, name="Gain")
+        gained_bsdf(tree, group_in, gain, bsdf, FRAME_INSET + COLUMN_STEP * (chain.column + 2))
+    colour = (
+        "Its colour is Color (1 + Fms (1 - E) / E) with Fms = C E_avg / (1 - C (1 - E_avg)) and "
+        "E_avg(r, eta) the side's average: the light the microfacets bounce more than once is "
+        "tinted by the colour, as in Blender's Multiscatter GGX glass." if physical else
+        "Its colour is Color / E, so every interface returns Color of what meets it.")
     description = description_text(spec, params, (
-        "Blender's %s %s (%s) whose colour is divided by E(mu, r, eta), the albedo of one "
+        "Blender's %s %s (%s) whose colour restores E(mu, r, eta), the albedo of one "
         "rough interface for the view's cosine at the normal it shades with (see '%s'), "
         "eta = IOR on a front face and 1 / IOR on a back face, read from the packed tables "
         "'%s ...'. Every interface returns all the light that meets it, entering and "
         "leaving, so a white solid glass object in an evenly lit white world is 100 %% "
-        "bright. Cycles only."
-        % (spec["distribution"], label, what, spec["normal_group"], glass["image"])))
+        "bright. %s Cycles only."
+        % (spec["distribution"], label, what, spec["normal_group"], glass["image"], colour)))
     set_tree_description(tree, description)
     mark_asset(tree, description, ["gloffuse", spec["distribution"], "glass"],
                asset_fields(params, "shader"))

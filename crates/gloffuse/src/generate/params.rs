@@ -229,6 +229,20 @@ pub struct GlassTable {
     pub glass_leaving: Option<Vec<f32>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reflection: Option<Vec<f32>>,
+    /// For the physical colour model: `E_avg(r, η)` of each node and side, laid out as the
+    /// E tables with every row alike (the groups read it as they read E).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub averages: Option<GlassAverages>,
+}
+
+/// `E_avg(r, η)` of the Glass and Refraction nodes, entering and leaving
+/// ([`DielectricIntegrator::average_albedo`]), in [`GlassTable`]'s layout.
+#[derive(Clone, Debug, Serialize)]
+pub struct GlassAverages {
+    pub glass_average_entering: Vec<f32>,
+    pub glass_average_leaving: Vec<f32>,
+    pub refraction_average_entering: Vec<f32>,
+    pub refraction_average_leaving: Vec<f32>,
 }
 
 /// Grid points per axis (view cosine, r) of each index slice of the glass groups' tables.
@@ -250,8 +264,9 @@ impl GlassTable {
     }
 
     /// The table of `distribution` for a masking family: 3.0–3.4's glass (separable) or
-    /// 3.6 and later's (height-correlated).
-    pub fn compute(distribution: Distribution, masking: Masking) -> Self {
+    /// 3.6 and later's (height-correlated); with the averages the physical colour model
+    /// needs if `color_model` is physical.
+    pub fn compute(distribution: Distribution, masking: Masking, color_model: ColorModel) -> Self {
         let from = Self::first_version(masking);
         let size = GLASS_TABLE_SIZE;
         let axis = Roughness::grid(size);
@@ -290,6 +305,27 @@ impl GlassTable {
             glass_entering: one_closure.then(|| e(DielectricNode::Glass, Side::Entering)),
             glass_leaving: one_closure.then(|| e(DielectricNode::Glass, Side::Leaving)),
             reflection: (!one_closure).then(|| packed(&|_, i, j| grid.reflection(i, j))),
+            averages: (color_model == ColorModel::Physical).then(|| {
+                let average = |node, side| {
+                    let values = DielectricIntegrator::default().average_grid(
+                        distribution,
+                        from,
+                        node,
+                        side,
+                        &axis,
+                    );
+                    packed(&|k, _, j| values[k][j])
+                };
+                GlassAverages {
+                    glass_average_entering: average(DielectricNode::Glass, Side::Entering),
+                    glass_average_leaving: average(DielectricNode::Glass, Side::Leaving),
+                    refraction_average_entering: average(
+                        DielectricNode::Refraction,
+                        Side::Entering,
+                    ),
+                    refraction_average_leaving: average(DielectricNode::Refraction, Side::Leaving),
+                }
+            }),
         }
     }
 }
@@ -596,7 +632,7 @@ impl GenerateParams {
             groups.extend(
                 distributions
                     .into_iter()
-                    .map(|d| group_spec(engine, d, &loaded, modes)),
+                    .map(|d| group_spec(engine, d, &loaded, modes, color_model)),
             );
         }
         let first = BlenderVersion::HEIGHT_CORRELATED_FROM;
@@ -644,6 +680,7 @@ fn group_spec(
     d: Distribution,
     loaded: &[(Masking, Coefficients, String)],
     modes: &[Mode],
+    color_model: ColorModel,
 ) -> GroupSpec {
     let wants = |m: Mode| modes.contains(&m);
     // Every per-pixel group reads the shading normal; all but the anisotropic one E(μ, r).
@@ -704,7 +741,7 @@ fn group_spec(
                         .then(|| AnisotropicTable::compute(d, *masking)),
                     glass_image: glass
                         .then(|| format!("Gloffuse E(mu, r, eta) ({}, {})", d.label(), masking)),
-                    glass_table: glass.then(|| GlassTable::compute(d, *masking)),
+                    glass_table: glass.then(|| GlassTable::compute(d, *masking, color_model)),
                 })
             })
             .collect(),
@@ -801,6 +838,62 @@ mod tests {
     use super::*;
     use crate::measure::{Dielectric, critical_cosine};
 
+    /// The physical colour model's tables carry E_avg of each node and side, every row
+    /// alike, at each slice's index and column's roughness; the exact model's carry none.
+    #[test]
+    fn physical_glass_tables_carry_the_averages() {
+        let q = DielectricIntegrator::default();
+        let n = GLASS_TABLE_SIZE;
+        let exact = GlassTable::compute(
+            Distribution::Beckmann,
+            Masking::HeightCorrelated,
+            ColorModel::Exact,
+        );
+        assert!(exact.averages.is_none());
+        let table = GlassTable::compute(
+            Distribution::Beckmann,
+            Masking::HeightCorrelated,
+            ColorModel::Physical,
+        );
+        let averages = table.averages.as_ref().unwrap();
+        for (values, node, side) in [
+            (
+                &averages.glass_average_entering,
+                DielectricNode::Glass,
+                Side::Entering,
+            ),
+            (
+                &averages.glass_average_leaving,
+                DielectricNode::Glass,
+                Side::Leaving,
+            ),
+            (
+                &averages.refraction_average_entering,
+                DielectricNode::Refraction,
+                Side::Entering,
+            ),
+            (
+                &averages.refraction_average_leaving,
+                DielectricNode::Refraction,
+                Side::Leaving,
+            ),
+        ] {
+            for (k, j) in [(0, 3), (5, 15), (11, 8)] {
+                let r = Roughness::new(j as f64 / (n - 1) as f64).unwrap();
+                let bsdf =
+                    Dielectric::new(node, Distribution::Beckmann, r, GlassForm::ONE_CLOSURE_FROM);
+                let want = q.average_albedo(&bsdf, side.eta(table.ior[k])) as f32;
+                for i in [0, 7, n - 1] {
+                    let got = values[(i * table.slices + k) * n + j];
+                    assert_eq!(
+                        got, want,
+                        "{node:?} {side:?} row {i}, slice {k}, column {j}"
+                    );
+                }
+            }
+        }
+    }
+
     /// Each table's texels are the integrator's E at their row's view cosine: μ = t^1.5 in
     /// every table but the leaving Refraction one, whose rows crowd about each slice's
     /// critical cosine (at it halfway up, at 0 and 1 in the first and last rows). Checked
@@ -813,7 +906,7 @@ mod tests {
             (Masking::Separable, BlenderVersion::OLDEST),
             (Masking::HeightCorrelated, GlassForm::ONE_CLOSURE_FROM),
         ] {
-            let table = GlassTable::compute(Distribution::Ggx, masking);
+            let table = GlassTable::compute(Distribution::Ggx, masking, ColorModel::Exact);
             let cases = [
                 (&table.refraction_leaving, DielectricNode::Refraction, true),
                 (
