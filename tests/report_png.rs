@@ -125,6 +125,7 @@ fn white_row(
         ring_targets: vec![[1.0; 3]; RINGS],
         worst_ring: 0.0,
         pass,
+        within_noise: false,
     }
 }
 

@@ -48,6 +48,13 @@ pub fn sentence(note: &Note) -> String {
             }
             s
         }
+        Note::WithinNoise { count, failing } => format!(
+            "{count} of the {failing} failing sphere{} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (a solid glass sphere's noise falls only about as n^-1/3 with the samples).",
+            if *failing == 1 { "" } else { "s" },
+            if *count == 1 { "es" } else { "" },
+            if *count == 1 { "its" } else { "their" },
+            if *count == 1 { "it" } else { "them" },
+        ),
     }
 }
 
@@ -101,6 +108,23 @@ mod tests {
             sentence(&notes[1]),
             "GGX: the coefficients were fitted for height-correlated masking, but Blender 3.4 uses separable masking; the preset 'blender-3' suits this Blender."
         );
+    }
+
+    #[test]
+    fn within_noise_counts_in_words() {
+        assert_eq!(
+            sentence(&Note::WithinNoise {
+                count: 1,
+                failing: 1
+            }),
+            "1 of the 1 failing sphere misses by no more than three standard errors of its own noise beyond the tolerance: more samples may pass it (a solid glass sphere's noise falls only about as n^-1/3 with the samples)."
+        );
+        let s = sentence(&Note::WithinNoise {
+            count: 2,
+            failing: 4,
+        });
+        assert!(s.starts_with("2 of the 4 failing spheres miss by no more than three standard errors of their own noise"), "{s}");
+        assert!(s.contains("may pass them"), "{s}");
     }
 
     #[test]

@@ -92,8 +92,19 @@ pub fn judge_row(
     mode: Mode,
 ) -> Row {
     let (brightness, deviation) = relative(corrected.mean_rgb, p.target);
-    let worst_ring = worst_ring(&corrected, &p.ring_targets);
-    let rings_flat = !mode.per_pixel() || worst_ring <= judging.ring_tolerance_percent / 100.0;
+    let (worst_ring, ring_error) = worst_ring(&corrected, &p.ring_targets);
+    let (tolerance, ring_tolerance) = (
+        judging.tolerance_percent / 100.0,
+        judging.ring_tolerance_percent / 100.0,
+    );
+    let mean_fails = deviation > tolerance;
+    let rings_fail = mode.per_pixel() && worst_ring > ring_tolerance;
+    let mean_error = corrected.standard_error / (p.target.iter().sum::<f64>() / 3.0);
+    // Off by no more than NOISE_ERRORS standard errors beyond the tolerance (NaN: never).
+    let within = |off: f64, tolerance: f64, error: f64| off - tolerance <= NOISE_ERRORS * error;
+    let within_noise = (mean_fails || rings_fail)
+        && (!mean_fails || within(deviation, tolerance, mean_error))
+        && (!rings_fail || within(worst_ring, ring_tolerance, ring_error));
     Row {
         id: slot.id,
         distribution: slot.distribution,
@@ -110,9 +121,15 @@ pub fn judge_row(
         predicted_corrected: p.corrected,
         ring_targets: p.ring_targets,
         worst_ring,
-        pass: deviation <= judging.tolerance_percent / 100.0 && rings_flat,
+        pass: !mean_fails && !rings_fail,
+        within_noise,
     }
 }
+
+/// A failing sphere whose every failing mean (the sphere's, its worst ring's) is off by no
+/// more than this many of its standard errors beyond the tolerance could pass with more
+/// samples: its verdict is the noise's as much as the group's.
+const NOISE_ERRORS: f64 = 3.0;
 
 /// A reference sphere: its mean relative to what it promises.
 pub fn reference(r: &PlanReference, stats: SphereStats, predictor: &Predictor) -> ReferenceSphere {
@@ -127,14 +144,21 @@ pub fn reference(r: &PlanReference, stats: SphereStats, predictor: &Predictor) -
 }
 
 /// The largest |ring mean / its target − 1| over the view-cosine rings (with at least
-/// [`MIN_RING_PIXELS`] pixels) and channels of a sphere.
-fn worst_ring(s: &SphereStats, targets: &[[f64; 3]]) -> f64 {
+/// [`MIN_RING_PIXELS`] pixels) and channels of a sphere, and that ring's standard error
+/// relative to its target.
+fn worst_ring(s: &SphereStats, targets: &[[f64; 3]]) -> (f64, f64) {
     s.rings
         .iter()
         .zip(targets)
         .filter(|(r, _)| r.pixels >= MIN_RING_PIXELS)
-        .map(|(r, &t)| relative(r.mean_rgb, t).1)
-        .fold(0.0, f64::max)
+        .map(|(r, t)| {
+            let error = r.standard_error / (t.iter().sum::<f64>() / 3.0);
+            (relative(r.mean_rgb, *t).1, error)
+        })
+        .fold(
+            (0.0, f64::NAN),
+            |worst, ring| if ring.0 > worst.0 { ring } else { worst },
+        )
 }
 
 #[cfg(test)]
@@ -157,6 +181,7 @@ mod tests {
                     mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64),
                     pixels: ring_pixels,
                     mean: ring_mean,
+                    standard_error: 0.001,
                     mean_rgb: [ring_mean; 3],
                 })
                 .collect(),
@@ -194,6 +219,38 @@ mod tests {
     fn row(mean: f64, ring_mean: f64, ring_pixels: usize, mode: Mode) -> Row {
         let (u, c) = (sphere(0.5, 0.5, 500), sphere(mean, ring_mean, ring_pixels));
         judge_row(&slot(), u, c, prediction(), JUDGING, mode)
+    }
+
+    /// A failing sphere is within its noise when each failing mean is off by no more than
+    /// three standard errors beyond its tolerance (here 50 % and, in the view modes, 25 %).
+    #[test]
+    fn a_failure_within_three_standard_errors_is_within_noise() {
+        let judged = |mean: f64, ring_mean: f64, error: f64, mode: Mode| {
+            let mut c = sphere(mean, ring_mean, 500);
+            c.standard_error = error;
+            for ring in &mut c.rings {
+                ring.standard_error = error;
+            }
+            judge_row(
+                &slot(),
+                sphere(0.5, 0.5, 500),
+                c,
+                prediction(),
+                JUDGING,
+                mode,
+            )
+        };
+        // The mean 0.6 beyond the tolerance: within 3 × 0.25, not 3 × 0.1.
+        assert!(judged(2.1, 1.0, 0.25, Mode::Roughness).within_noise);
+        assert!(!judged(2.1, 1.0, 0.1, Mode::Roughness).within_noise);
+        // A ring 0.15 beyond: within 3 × 0.06, not 3 × 0.04 (the mean passes).
+        assert!(judged(1.0, 1.4, 0.06, Mode::View).within_noise);
+        assert!(!judged(1.0, 1.4, 0.04, Mode::View).within_noise);
+        // Both fail: both must be within.
+        assert!(!judged(2.6, 1.4, 0.06, Mode::View).within_noise);
+        // A pass is never within noise; an unknown error never.
+        assert!(!judged(1.0, 1.0, 1.0, Mode::View).within_noise);
+        assert!(!judged(2.1, 1.0, f64::NAN, Mode::Roughness).within_noise);
     }
 
     #[test]

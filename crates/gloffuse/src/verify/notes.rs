@@ -20,7 +20,17 @@ pub fn notes(
         .chain(foreign_groups(sweep, engine, version))
         .chain(masking_mismatches(sweep, engine, version))
         .chain(display_referred(sweep, rows))
+        .chain(within_noise(rows))
         .collect()
+}
+
+/// Failing spheres whose verdict more samples could change.
+fn within_noise(rows: &[Row]) -> Option<Note> {
+    let count = rows.iter().filter(|r| r.within_noise).count();
+    (count > 0).then(|| Note::WithinNoise {
+        count,
+        failing: rows.iter().filter(|r| !r.pass).count(),
+    })
 }
 
 /// The groups are calibrated for another engine than the one rendering.
@@ -163,7 +173,38 @@ mod tests {
             ring_targets: vec![],
             worst_ring: 0.0,
             pass,
+            within_noise: false,
         }
+    }
+
+    /// The failing spheres within their noise are counted, the others not; none, no note.
+    #[test]
+    fn failing_spheres_within_their_noise_are_noted() {
+        let c = preset("blender-4");
+        let ds = [Distribution::Ggx];
+        let mut rows = vec![
+            row(Distribution::Ggx, 0.5, 1.0, true),
+            row(Distribution::Ggx, 0.75, 0.97, false),
+            row(Distribution::Ggx, 1.0, 0.95, false),
+        ];
+        let noted = |rows: &[Row]| {
+            notes(
+                &sweep(&c, &ds, &[]),
+                Engine::Cycles,
+                version("4.5"),
+                None,
+                rows,
+            )
+        };
+        assert_eq!(noted(&rows), []);
+        rows[2].within_noise = true;
+        assert_eq!(
+            noted(&rows),
+            [Note::WithinNoise {
+                count: 1,
+                failing: 2
+            }]
+        );
     }
 
     #[test]

@@ -18,6 +18,8 @@ pub struct Ring {
     pub pixels: usize,
     /// Mean brightness (0–1) of the ring's fully covered pixels; NaN if it holds none.
     pub mean: f64,
+    /// Estimated standard error of `mean` (from its pixels' spread); NaN with fewer than two.
+    pub standard_error: f64,
     /// The same per channel (R, G, B).
     pub mean_rgb: [f64; 3],
 }
@@ -104,15 +106,18 @@ pub fn sphere_stats(
             } else {
                 f64::NAN
             };
+            let mut standard_error = f64::NAN;
             if n > 1 {
                 let var = (ring_sq[k] - n as f64 * m * m) / (n as f64 - 1.0);
                 var_sum += var.max(0.0) * n as f64;
+                standard_error = (var.max(0.0) / n as f64).sqrt();
             }
             n_total += n;
             Ring {
                 mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64),
                 pixels: n,
                 mean: m,
+                standard_error,
                 mean_rgb: ring_channel[k].map(|sum| sum / n as f64),
             }
         })

@@ -110,6 +110,9 @@ pub struct Row {
     /// Every channel's |mean / target − 1| ≤ tolerance (and, in the view modes, every ring
     /// within the ring tolerance).
     pub pass: bool,
+    /// It fails, but each failing mean (the sphere's, its worst ring's) is off by no more
+    /// than three of its standard errors beyond the tolerance: more samples may pass it.
+    pub within_noise: bool,
 }
 
 /// `GGX`, or in layered mode `GGX, IOR 1.5`: the name of a row's series.
@@ -212,6 +215,8 @@ pub enum Note {
         #[serde(skip_serializing_if = "Option::is_none")]
         over: Option<WorstSphere>,
     },
+    /// `count` of the `failing` spheres fail within their noise (`Row::within_noise`).
+    WithinNoise { count: usize, failing: usize },
 }
 
 impl Note {
