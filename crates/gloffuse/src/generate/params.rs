@@ -274,7 +274,8 @@ impl GlassTable {
             .iter()
             .map(|t| grazing_crowded(t.get()).max(1e-3))
             .collect();
-        let grid = DielectricIntegrator::default().grid(distribution, from, &mus, &axis, &Quiet);
+        let integrator = DielectricIntegrator::default();
+        let grid = integrator.grid(distribution, from, &mus, &axis, &Quiet);
         let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
             let mut values = Vec::with_capacity(size * size * coat::SLICES);
             for i in 0..size {
@@ -286,8 +287,7 @@ impl GlassTable {
         };
         let e = |node, side| packed(&|k, i, j| grid.e(node, side, k, i, j));
         let one_closure = GlassForm::of(from) == GlassForm::OneClosure;
-        let leaving =
-            DielectricIntegrator::default().refraction_leaving(distribution, from, &axis, &axis);
+        let leaving = integrator.refraction_leaving(distribution, from, &axis, &axis);
         GlassTable {
             size,
             slices: coat::SLICES,
@@ -307,13 +307,7 @@ impl GlassTable {
             reflection: (!one_closure).then(|| packed(&|_, i, j| grid.reflection(i, j))),
             averages: (color_model == ColorModel::Physical).then(|| {
                 let average = |node, side| {
-                    let values = DielectricIntegrator::default().average_grid(
-                        distribution,
-                        from,
-                        node,
-                        side,
-                        &axis,
-                    );
+                    let values = integrator.average_grid(distribution, from, node, side, &axis);
                     packed(&|k, _, j| values[k][j])
                 };
                 GlassAverages {

@@ -99,7 +99,7 @@ pub fn judge_row(
     );
     let mean_fails = deviation > tolerance;
     let rings_fail = mode.per_pixel() && worst_ring > ring_tolerance;
-    let mean_error = corrected.standard_error / (p.target.iter().sum::<f64>() / 3.0);
+    let mean_error = relative_error(corrected.standard_error, p.target);
     // Off by no more than NOISE_ERRORS standard errors beyond the tolerance (NaN: never).
     let within = |off: f64, tolerance: f64, error: f64| off - tolerance <= NOISE_ERRORS * error;
     let within_noise = (mean_fails || rings_fail)
@@ -152,13 +152,20 @@ fn worst_ring(s: &SphereStats, targets: &[[f64; 3]]) -> (f64, f64) {
         .zip(targets)
         .filter(|(r, _)| r.pixels >= MIN_RING_PIXELS)
         .map(|(r, t)| {
-            let error = r.standard_error / (t.iter().sum::<f64>() / 3.0);
-            (relative(r.mean_rgb, *t).1, error)
+            (
+                relative(r.mean_rgb, *t).1,
+                relative_error(r.standard_error, *t),
+            )
         })
         .fold(
             (0.0, f64::NAN),
             |worst, ring| if ring.0 > worst.0 { ring } else { worst },
         )
+}
+
+/// A standard error of a channel-averaged mean relative to the channels' average target.
+fn relative_error(error: f64, target: [f64; 3]) -> f64 {
+    error / (target.iter().sum::<f64>() / 3.0)
 }
 
 #[cfg(test)]
