@@ -181,8 +181,15 @@ fn sigterm_and_sighup_stop_blender_and_leave_the_file_alone() {
                 assert!(Instant::now() < deadline, "Blender {label} never started");
                 std::thread::sleep(Duration::from_millis(20));
             };
-            // Into its run: Python has started and is importing bpy or building.
-            std::thread::sleep(Duration::from_millis(400));
+            // Freeze Blender mid-run so the signal cannot lose a race with a fast job (a
+            // 400 ms pause once let bpy 4.5 finish first on CI); gloffuse must still stop
+            // a stopped group.
+            // SAFETY: killpg only sends a signal to the group of the Blender we found.
+            assert_eq!(
+                unsafe { libc::killpg(blender_pid as libc::pid_t, libc::SIGSTOP) },
+                0,
+                "Blender {label} ended before it could be frozen"
+            );
             // SAFETY: kill only sends a signal to the child we spawned.
             assert_eq!(unsafe { libc::kill(pid as libc::pid_t, signal) }, 0);
             let out = child.wait_with_output().unwrap();
