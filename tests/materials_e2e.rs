@@ -627,8 +627,10 @@ fn spread(ratios: &[f64]) -> (f64, f64, f64) {
 /// Multiscatter GGX glass is itself up to 10 % short in the furnace), 0–5 % brighter on
 /// average; and Blender's single-scatter GGX glass is more than 20 % darker on average, so
 /// the scene needs the compensation. In 3.4, whose Multiscatter GGX glass is a random walk
-/// with a lobe of its own (blocks 24 % darker to 10 % brighter), only the white group's
-/// average is judged: within 5 % below and 2 % above it (measured 0.963).
+/// that keeps all the light, the group is that glass: within 0.5 % of it on average and 3 %
+/// in every block, white and tinted (measured: identical in one run; in another the white
+/// pair 0.9777–1.0088 per block, 0.9998 on average, on noise; the gain on single-scatter
+/// glass this replaced was 0.963 on average, 0.76–1.10 per block).
 #[test]
 fn glass_follows_multiscatter_ggx_in_a_lit_bumped_scene() {
     const GREEN: [f64; 3] = [0.6, 0.9, 0.75];
@@ -665,7 +667,7 @@ fn glass_follows_multiscatter_ggx_in_a_lit_bumped_scene() {
             block_ratios(&blocks, &images[name], |i, c| channel(reference, i, c)).concat()
         };
         let mut failures = Vec::new();
-        // 3.4's random walk has a lobe of its own: there only the white mean is judged.
+        // In 3.4 the group is Blender's random-walk Multiscatter GGX glass itself.
         let random_walk = label == "3.4";
         for (name, reference) in [
             ("group", "multiscatter"),
@@ -678,7 +680,7 @@ fn glass_follows_multiscatter_ggx_in_a_lit_bumped_scene() {
                 blocks.len()
             );
             let off = if random_walk {
-                name == "group" && !(0.95..=1.02).contains(&mean)
+                low < 0.97 || high > 1.03 || !(0.995..=1.005).contains(&mean)
             } else {
                 low < 0.99 || high > 1.08 || !(1.0..=1.05).contains(&mean)
             };

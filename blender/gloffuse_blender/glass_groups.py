@@ -26,6 +26,13 @@
 # mu = mu_c + (1 - mu_c) (2s - 1)^2 above it, mu_c - mu_c (1 - 2s)^2 below.
 # mu comes from the shading-normal group (normal_group.py).
 #
+# Where Blender itself keeps the light, the group is Blender's own: in 3.0-3.5
+# the GGX Glass group is the Multiscatter GGX Glass BSDF, a random walk that
+# returns every bit of light with about a thousandth of the gain's noise in a
+# rough dense sphere (glass_table["glass_group"] == "multiscatter"; the tables
+# then carry nothing for the Glass node). Its colour is the walk's: light that
+# bounces k times among the microfacets is tinted k times.
+#
 # Colour (params["color_model"]): "exact" gives the node Color / E, so every
 # interface returns Color of what meets it; "physical" gives it
 # Color (1 + Fms (1 - E) / E) with Fms = C E_avg / (1 - C (1 - E_avg)) and
@@ -134,14 +141,47 @@ def two_closure_albedo(tree, chain, glass, group_in, cell, n, refracted, frame):
 
 def build_glass_group(spec, params, node):
     """Color, Roughness, IOR, Normal -> BSDF: Blender's `node` ("glass" or
-    "refraction") of colour Color / E(mu, r, eta)."""
+    "refraction") of colour Color / E(mu, r, eta), or Blender's own
+    Multiscatter GGX glass where that keeps the light."""
     glass = spec["glass"]
-    kind, label, what = GLASS_NODES[node]
     tree = reuse_or_create_group(glass["%s_group" % node])
     ensure_interface(tree, glass_sockets(dict(glass, spec=spec)))
-    nodes, links = tree.nodes, tree.links
-    group_in = nodes.new("NodeGroupInput")
+    group_in = tree.nodes.new("NodeGroupInput")
     group_in.location = (0.0, 0.0)
+    if node == "glass" and glass["table"].get("glass_group") == "multiscatter":
+        description = multiscatter_glass(tree, spec, params, group_in)
+    else:
+        description = gained_glass(tree, spec, params, group_in, node)
+    set_tree_description(tree, description)
+    mark_asset(tree, description, ["gloffuse", spec["distribution"], "glass"],
+               asset_fields(params, "shader"))
+    return tree
+
+
+def multiscatter_glass(tree, spec, params, group_in):
+    """The group as Blender 3.0-3.5's Multiscatter GGX Glass BSDF (a random
+    walk that keeps all the light), its inputs passed through; its
+    description."""
+    bsdf = tree.nodes.new("ShaderNodeBsdfGlass")
+    bsdf.name = "Glass BSDF"
+    bsdf.distribution = "MULTI_GGX"
+    for socket in ("Roughness", "IOR", "Normal"):
+        tree.links.new(group_in.outputs[socket], bsdf.inputs[socket])
+    colored_bsdf(tree, group_in.outputs["Color"], bsdf, 0.0)
+    return description_text(spec, params, (
+        "Blender's Multiscatter GGX Glass BSDF (reflection and refraction), which in this "
+        "Blender is a random walk over the microfacets that returns all the light meeting "
+        "it, entering and leaving: a white solid glass object in an evenly lit white world "
+        "is 100 % bright, with far less noise than a gain on the single-scatter GGX glass. "
+        "Its colour tints light once per bounce among the microfacets. Cycles only."))
+
+
+def gained_glass(tree, spec, params, group_in, node):
+    """The group as Blender's `node` of colour Color / E(mu, r, eta) (or the
+    physical colour), E read from the tables; its description."""
+    glass = spec["glass"]
+    kind, label, what = GLASS_NODES[node]
+    nodes, links = tree.nodes, tree.links
     frame = new_frame(tree, "Albedo frame",
                       "Gain = 1 / E(mu, r, eta): eta = IOR on a front face, 1 / IOR on a back face")
     r = clamped_roughness(tree, group_in, frame)
@@ -189,7 +229,7 @@ def build_glass_group(spec, params, node):
         "E_avg(r, eta) the side's average: the light the microfacets bounce more than once is "
         "tinted by the colour, as in Blender's Multiscatter GGX glass." if physical else
         "Its colour is Color / E, so every interface returns Color of what meets it.")
-    description = description_text(spec, params, (
+    return description_text(spec, params, (
         "Blender's %s %s (%s) whose colour restores E(mu, r, eta), the albedo of one "
         "rough interface for the view's cosine at the normal it shades with (see '%s'), "
         "eta = IOR on a front face and 1 / IOR on a back face, read from the packed tables "
@@ -197,7 +237,3 @@ def build_glass_group(spec, params, node):
         "leaving, so a white solid glass object in an evenly lit white world is 100 %% "
         "bright. %s Cycles only."
         % (spec["distribution"], label, what, spec["normal_group"], glass["image"], colour)))
-    set_tree_description(tree, description)
-    mark_asset(tree, description, ["gloffuse", spec["distribution"], "glass"],
-               asset_fields(params, "shader"))
-    return tree

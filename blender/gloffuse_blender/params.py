@@ -221,6 +221,9 @@ def validate_params(params):
                 raise ValueError("%s.glass.table needs integer size and slices of at least 2" % where)
             if finite_list([table.get("ior_max")], "%s.glass.table.ior_max" % where)[0] <= 1.0:
                 raise ValueError("%s.glass.table.ior_max must be above 1" % where)
+            if table.get("glass_group") not in ("gain", "multiscatter"):
+                raise ValueError("%s.glass.table.glass_group is %r; expected 'gain' or "
+                                 "'multiscatter'" % (where, table.get("glass_group")))
         for key in ("description", "coefficients_source"):
             if not isinstance(spec.get(key, ""), str):
                 raise ValueError("%s.%s must be a string" % (where, key))
