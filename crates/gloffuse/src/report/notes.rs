@@ -48,12 +48,17 @@ pub fn sentence(note: &Note) -> String {
             }
             s
         }
-        Note::WithinNoise { count, failing } => format!(
-            "{count} of the {failing} failing sphere{} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (a solid glass sphere's noise falls only about as n^-1/3 with the samples).",
+        Note::WithinNoise {
+            count,
+            failing,
+            samples,
+        } => format!(
+            "{count} of the {failing} failing sphere{} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (rendered with {samples}; try --spp {}, which halves a sphere's noise and a solid glass sphere's by about a third).",
             if *failing == 1 { "" } else { "s" },
             if *count == 1 { "es" } else { "" },
             if *count == 1 { "its" } else { "their" },
             if *count == 1 { "it" } else { "them" },
+            samples.saturating_mul(4),
         ),
     }
 }
@@ -115,13 +120,15 @@ mod tests {
         assert_eq!(
             sentence(&Note::WithinNoise {
                 count: 1,
-                failing: 1
+                failing: 1,
+                samples: 256
             }),
-            "1 of the 1 failing sphere misses by no more than three standard errors of its own noise beyond the tolerance: more samples may pass it (a solid glass sphere's noise falls only about as n^-1/3 with the samples)."
+            "1 of the 1 failing sphere misses by no more than three standard errors of its own noise beyond the tolerance: more samples may pass it (rendered with 256; try --spp 1024, which halves a sphere's noise and a solid glass sphere's by about a third)."
         );
         let s = sentence(&Note::WithinNoise {
             count: 2,
             failing: 4,
+            samples: 32,
         });
         assert!(s.starts_with("2 of the 4 failing spheres miss by no more than three standard errors of their own noise"), "{s}");
         assert!(s.contains("may pass them"), "{s}");

@@ -13,6 +13,7 @@ pub fn notes(
     version: BlenderVersion,
     lighting: Option<f64>,
     rows: &[Row],
+    samples: u32,
 ) -> Vec<Note> {
     let lighting = lighting.map(|brightness| Note::Lighting { engine, brightness });
     lighting
@@ -20,16 +21,17 @@ pub fn notes(
         .chain(foreign_groups(sweep, engine, version))
         .chain(masking_mismatches(sweep, engine, version))
         .chain(display_referred(sweep, rows))
-        .chain(within_noise(rows))
+        .chain(within_noise(rows, samples))
         .collect()
 }
 
-/// Failing spheres whose verdict more samples could change.
-fn within_noise(rows: &[Row]) -> Option<Note> {
+/// Failing spheres whose verdict more samples could change, rendered with `samples`.
+fn within_noise(rows: &[Row], samples: u32) -> Option<Note> {
     let count = rows.iter().filter(|r| r.within_noise).count();
     (count > 0).then(|| Note::WithinNoise {
         count,
         failing: rows.iter().filter(|r| !r.pass).count(),
+        samples,
     })
 }
 
@@ -194,6 +196,7 @@ mod tests {
                 version("4.5"),
                 None,
                 rows,
+                256,
             )
         };
         assert_eq!(noted(&rows), []);
@@ -202,7 +205,8 @@ mod tests {
             noted(&rows),
             [Note::WithinNoise {
                 count: 1,
-                failing: 2
+                failing: 2,
+                samples: 256
             }]
         );
     }
@@ -217,6 +221,7 @@ mod tests {
             version("4.5"),
             None,
             &[],
+            32,
         );
         assert_eq!(n, []);
     }
@@ -232,6 +237,7 @@ mod tests {
             version("3.4"),
             None,
             &[],
+            32,
         );
         assert_eq!(
             n,
@@ -250,7 +256,7 @@ mod tests {
         let c = preset("blender-4");
         let ds = Distribution::ALL;
         let s = sweep(&c, &ds, &[]);
-        let n = notes(&s, Engine::Eevee, version("4.5"), Some(0.992), &[]);
+        let n = notes(&s, Engine::Eevee, version("4.5"), Some(0.992), &[], 1);
         assert_eq!(
             n,
             [
@@ -289,6 +295,7 @@ mod tests {
             version("4.5"),
             None,
             &rows,
+            32,
         );
         let [Note::DisplayReferred { under, over, .. }] = &n[..] else {
             panic!("{n:?}");
@@ -309,6 +316,7 @@ mod tests {
             version("4.5"),
             None,
             &rows[3..],
+            32,
         );
         assert!(matches!(
             &n[..],

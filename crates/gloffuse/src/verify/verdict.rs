@@ -215,8 +215,13 @@ pub enum Note {
         #[serde(skip_serializing_if = "Option::is_none")]
         over: Option<WorstSphere>,
     },
-    /// `count` of the `failing` spheres fail within their noise (`Row::within_noise`).
-    WithinNoise { count: usize, failing: usize },
+    /// `count` of the `failing` spheres fail within their noise (`Row::within_noise`),
+    /// rendered with `samples` per pixel.
+    WithinNoise {
+        count: usize,
+        failing: usize,
+        samples: u32,
+    },
 }
 
 impl Note {
