@@ -7,14 +7,19 @@ use glam::DVec3;
 use gloffuse::measure::fresnel;
 use gloffuse::measure::{
     BlenderVersion, Dielectric, DielectricIntegrator, DielectricNode, Distribution, GlassForm,
-    Roughness,
+    Roughness, Sampler,
 };
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
+/// The lobe itself, drawn exactly: the oracles here evaluate the BSDF, not 3.0–3.4's Beckmann
+/// slope table (`measure::beckmann_table` checks that against a Monte Carlo walk through it).
 fn bsdf(node: DielectricNode, d: Distribution, r: f64, version: &str) -> Dielectric {
     let version: BlenderVersion = version.parse().unwrap();
-    Dielectric::new(node, d, Roughness::new(r).unwrap(), version)
+    Dielectric {
+        sampler: Sampler::Exact,
+        ..Dielectric::new(node, d, Roughness::new(r).unwrap(), version)
+    }
 }
 
 /// `f cos` of the lobe toward `l` for the view `v`, evaluated as a BSDF: reflection

@@ -18,13 +18,13 @@ const PX: usize = 64;
 const SAMPLES: u32 = 512;
 const RINGS: usize = 5;
 /// Per ring, |render − predicted| (absolute albedo). Measured at 512 spp: ≤ 0.0015 in 4.5
-/// and 5.0. Blender 3.4 renders a little more than its lobes return in two places: inside
-/// the glass past the critical angle (GGX: 0.004, where the refraction closure weighs 1e-4
-/// but is still picked), and with Beckmann (up to 0.013; its sampler draws the visible
-/// normals from a table, docs/PHYSICS.md §15).
+/// and 5.0. Blender 3.4 renders a little more than its lobes return inside the glass past
+/// the critical angle (GGX: 0.004, Beckmann: 0.0086, where the refraction closure weighs
+/// 1e-4 but is still picked); elsewhere within 0.0013, its Beckmann sampler's slope table
+/// (up to 0.013 more than the exact lobe) in the prediction (docs/PHYSICS.md §15).
 fn ring_tolerance(version: &str, d: Distribution) -> f64 {
     match (version, d) {
-        ("3.4", Distribution::Beckmann) => 0.015,
+        ("3.4", Distribution::Beckmann) => 0.01,
         ("3.4", _) => 0.006,
         _ => 0.004,
     }
@@ -340,14 +340,12 @@ const BLENDERS_OWN: [Solid; 2] = [
 ];
 
 /// What a group's solid sphere must do in Blender `label`: (mean, every ring, the rim)
-/// within these of 100 %. The goal is 2 %, 3 % and 3 %. Blender 3.4 misses it with
-/// Beckmann, whose sampler returns up to 1.3 % more than its lobes at each interface (2.3 %
-/// for the sphere at r 0.9, IOR 1.8; docs/RESULTS.md), and at the rim of its Refraction
-/// group (GGX r 0.5, IOR 1.33: 96.63 % at 512 spp, where 4.5.15 and 5.0.1 give 99.3–99.6 %;
-/// not explained yet).
+/// within these of 100 %. The goal is 2 %, 3 % and 3 %. Blender 3.4 misses it at the rim
+/// of its Refraction group (GGX r 0.5, IOR 1.33: 96.63 % at 512 spp, where 4.5.15 and 5.0.1
+/// give 99.3–99.6 %; not explained yet). (Its Beckmann glass, 2.3 % bright before the
+/// tables modelled its sampler's slope table, now meets the goal.)
 fn solid_tolerance(label: &str, c: &Solid) -> (f64, f64, f64) {
     match (label, c.distribution, c.node) {
-        ("3.4", "BECKMANN", _) => (0.035, 0.035, 0.035),
         ("3.4", _, DielectricNode::Refraction) => (0.02, 0.03, 0.04),
         _ => (0.02, 0.03, 0.03),
     }
