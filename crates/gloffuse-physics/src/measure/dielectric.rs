@@ -382,7 +382,8 @@ impl DielectricIntegrator {
             return None;
         }
         let sin = (1.0 - cos * cos).sqrt();
-        let cot = cos / sin;
+        // The density is 0 beyond cot θ, and negligible beyond −TAIL.
+        let top = (cos / sin).min(-TAIL);
         let table = SlopeTable::cycles();
         let cells = beckmann_table::SIZE - 1;
         // The exact marginal density of the slope along the view, normalised.
@@ -391,8 +392,8 @@ impl DielectricIntegrator {
             .marginal
             .iter()
             .map(|&(t, w)| {
-                let x = TAIL + (cot - TAIL) * t;
-                w * (cot - TAIL) * unnormalised(x)
+                let x = TAIL + (top - TAIL) * t;
+                w * (top - TAIL) * unnormalised(x)
             })
             .sum();
         // The sample weight averaged over the slope across the view.
@@ -419,7 +420,7 @@ impl DielectricIntegrator {
                 .windows(2)
                 .map(|k| (k[0], k[1], 1.0 / (cells as f64 * (k[1] - k[0])))),
         );
-        pieces.push((knots[cells], cot.max(knots[cells]), 0.0));
+        pieces.push((knots[cells], top.max(knots[cells]), 0.0));
         let (mut reflected, mut refracted) = (0.0, 0.0);
         for (from, to, density) in pieces {
             if to - from < 1e-12 {
@@ -437,7 +438,8 @@ impl DielectricIntegrator {
     }
 }
 
-/// The exact marginal's integrals start here: its mass below is under 1e-35.
+/// The exact marginal's integrals run from here to at most −TAIL: its mass beyond is under
+/// 1e-35.
 const TAIL: f64 = -9.0;
 /// Gauss nodes of the exact marginal's normalising integral.
 const MARGINAL_NODES: usize = 400;
