@@ -53,7 +53,7 @@ pub fn sentence(note: &Note) -> String {
             failing,
             samples,
         } => format!(
-            "{count} of the {failing} failing sphere{} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (rendered with {samples} samples per pixel; {} halve a sphere's noise and a solid glass sphere's by about a third).",
+            "{count} of the {failing} failing sphere{} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (rendered with {samples} samples per pixel; four times as many, {}, would halve a sphere's noise and cut a solid glass sphere's by about a third).",
             if *failing == 1 { "" } else { "s" },
             if *count == 1 { "es" } else { "" },
             if *count == 1 { "its" } else { "their" },
@@ -123,7 +123,7 @@ mod tests {
                 failing: 1,
                 samples: 256
             }),
-            "1 of the 1 failing sphere misses by no more than three standard errors of its own noise beyond the tolerance: more samples may pass it (rendered with 256 samples per pixel; 1024 halve a sphere's noise and a solid glass sphere's by about a third)."
+            "1 of the 1 failing sphere misses by no more than three standard errors of its own noise beyond the tolerance: more samples may pass it (rendered with 256 samples per pixel; four times as many, 1024, would halve a sphere's noise and cut a solid glass sphere's by about a third)."
         );
         let s = sentence(&Note::WithinNoise {
             count: 2,
