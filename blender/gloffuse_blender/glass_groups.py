@@ -162,8 +162,9 @@ def multiscatter_glass(tree, spec, params, group_in):
     """The group as Blender 3.0-3.5's Multiscatter GGX Glass BSDF (a random
     walk that keeps all the light), its inputs passed through; its
     description."""
-    bsdf = tree.nodes.new("ShaderNodeBsdfGlass")
-    bsdf.name = "Glass BSDF"
+    kind, label, _ = GLASS_NODES["glass"]
+    bsdf = tree.nodes.new(kind)
+    bsdf.name = label
     bsdf.distribution = "MULTI_GGX"
     for socket in ("Roughness", "IOR", "Normal"):
         tree.links.new(group_in.outputs[socket], bsdf.inputs[socket])

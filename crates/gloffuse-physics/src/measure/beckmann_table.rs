@@ -25,6 +25,12 @@ const SLOPE_MAX: f64 = 6.0;
 /// At or above this stretched view cosine Cycles samples the lobe exactly.
 pub const EXACT_FROM: f64 = 0.99999;
 
+/// The table's row coordinate for an isotropic lobe of width `alpha` and the view cosine
+/// `mu`: the cosine of the view stretched by α, `μ / √(μ² + α² (1 − μ²))`.
+pub fn stretched_cosine(mu: f64, alpha: f64) -> f64 {
+    mu / (mu * mu + alpha * alpha * (1.0 - mu * mu)).sqrt()
+}
+
 /// The table: `values[row * SIZE + column]`, the slope for view cosine `row / 255` and
 /// random number about `column / 255`.
 pub struct SlopeTable {

@@ -377,7 +377,7 @@ impl DielectricIntegrator {
     ) -> Option<(f64, f64)> {
         let a = bsdf.microfacet.alpha;
         let mu = v.z;
-        let cos = mu / (mu * mu + a * a * (1.0 - mu * mu)).sqrt();
+        let cos = beckmann_table::stretched_cosine(mu, a);
         if cos >= beckmann_table::EXACT_FROM {
             return None;
         }
@@ -717,7 +717,7 @@ mod tests {
             let a = bsdf.microfacet.alpha;
             let view = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
             let lambda_v = bsdf.microfacet.lambda(mu);
-            let cos = mu / (mu * mu + a * a * (1.0 - mu * mu)).sqrt();
+            let cos = beckmann_table::stretched_cosine(mu, a);
             let n = 2_000_000;
             let (mut sum, mut sum2): ((f64, f64), f64) = ((0.0, 0.0), 0.0);
             for _ in 0..n {
