@@ -128,6 +128,7 @@ fn stages_import_only_the_stages_before_them() {
     for infra in [
         "blender",
         "blend_file.rs",
+        "file_lock.rs",
         "output.rs",
         "shard.rs",
         "user_blend.rs",

@@ -34,7 +34,14 @@ from .compat import blender_version_string, filter_glossy_property, material_nod
 from .furnace import furnace_place_materials, furnace_stage, render_sweep
 from .groups import build_all, group_names
 from .params import resolve_params
-from .runtime import result_line, run_main, save_blend
+from .runtime import (
+    ScriptArgumentParser,
+    parse_script_args,
+    result_line,
+    run_main,
+    save_blend,
+    shown_path,
+)
 
 # Cycles' path depth in the audit: deep enough that glass and layered
 # materials lose next to nothing to the bounce limit (the twins are judged
@@ -57,7 +64,6 @@ def audit_params(document):
     audit_require(isinstance(document, dict), "the parameter document must be an object")
     section = document.get("audit")
     audit_require(isinstance(section, dict), "the document has no \"audit\" object")
-    audit_require(isinstance(section.get("file"), str) and section["file"], "\"file\" must be a path")
     render = bool(section.get("render", True))
     audit_require(not render or isinstance(section.get("output"), str), "\"output\" must be a path")
     audit_require(isinstance(section.get("rules"), list), "\"rules\" must be a list")
@@ -120,7 +126,7 @@ def build_twin_groups(document):
     return before, kept
 
 
-def fix_and_save(entries, document, audit, groups):
+def fix_and_save(entries, document, args, groups):
     """Apply every replacement to the real materials (shared group trees in
     place), drop what this run added and nothing uses, save the copy."""
     built = build_twin_groups(document) if group_needs(entries, groups) else None
@@ -136,8 +142,8 @@ def fix_and_save(entries, document, audit, groups):
     if built is not None:
         remove_unused_added(built[0])
         restore_groups(built[1])
-    path = save_blend(audit["fix_output"], bool(audit.get("compress")))
-    return {"path": path, "replaced": replaced, "materials": materials}
+    path = save_blend(args.save, args.compress)
+    return {"path": shown_path(path), "replaced": replaced, "materials": materials}
 
 
 # --- the furnace -------------------------------------------------------------------
@@ -224,31 +230,48 @@ def open_user_file(path):
     return path
 
 
+def parse_audit_args(argv=None):
+    """The file's paths travel as arguments, not in the document: a file name need not be
+    UTF-8 (JSON holds only text), and an argument reaches Python byte for byte
+    (surrogate-escaped), which Blender turns back into the very bytes when it opens or
+    saves the path."""
+    parser = ScriptArgumentParser(prog="gloffuse-audit",
+                                  description="Audit the materials of one .blend file.")
+    parser.add_argument("--open", metavar="IN.blend", required=True,
+                        help="the .blend file to audit (opened, never saved)")
+    parser.add_argument("--save", metavar="OUT.blend",
+                        help="save a fixed copy here (default: no fix)")
+    parser.add_argument("--compress", action="store_true",
+                        help="save the fixed copy compressed (as the file opened was)")
+    return parse_script_args(parser, argv)
+
+
 def audit_main(document_text):
     document = json.loads(document_text)
     audit = audit_params(document)
+    args = parse_audit_args()
     rules = applicable_rules(audit["rules"])
     groups = twin_groups(audit)
-    path = open_user_file(audit["file"])
+    path = open_user_file(args.open)
 
     start = time.perf_counter()
     file_findings = scan_scenes(rules)
     entries = scan_file(rules, groups)
     scan_seconds = time.perf_counter() - start
 
-    needs = group_needs(entries, groups) if audit["render"] or audit.get("fix_output") else []
+    needs = group_needs(entries, groups) if audit["render"] or args.save else []
     missing = [need for need in needs if need not in provided_groups(document)]
     if missing:
         # The groups' tables take gloffuse seconds to compute: it sends them only
         # to a job that asks, and runs it again.
-        print(result_line({"blender_version": blender_version_string(), "file": path,
+        print(result_line({"blender_version": blender_version_string(), "file": shown_path(path),
                            "materials": [], "needs": missing, "scan_seconds": scan_seconds}))
         sys.stdout.flush()
         return
 
     fixed = None
-    if audit.get("fix_output"):
-        fixed = fix_and_save(entries, document, audit, groups)
+    if args.save:
+        fixed = fix_and_save(entries, document, args, groups)
         if audit["render"]:
             # The furnace shows the materials as authored: start again from the file.
             open_user_file(path)
@@ -266,7 +289,7 @@ def audit_main(document_text):
 
     result = {
         "blender_version": blender_version_string(),
-        "file": path,
+        "file": shown_path(path),
         "output": os.path.abspath(audit["output"]) if scene is not None else None,
         "width": scene.render.resolution_x if scene is not None else 0,
         "height": scene.render.resolution_y if scene is not None else 0,

@@ -156,6 +156,15 @@ pub fn main() -> ExitCode {
         out.flush()?;
         Ok(o)
     });
+    // A stop that came while held work was finishing (after its last check): the work is
+    // whole, but the exit code still says the command was stopped.
+    let signal = SIGNAL.load(Ordering::SeqCst);
+    if signal != 0 && outcome.is_ok() {
+        eprintln_quietly(
+            "gloffuse: stopped as it finished; what it wrote is complete and reported above",
+        );
+        return ExitCode::from(stopped_code(signal));
+    }
     match outcome {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
@@ -319,6 +328,10 @@ fn audit(
     if let Some(path) = &a.junit {
         check_destination(path)?;
     }
+    // The report is staged in a folder beside its destination: a stop waits for the next
+    // check (the library's between files, this one's before the report is written), so that
+    // the staging folder is removed and the message says what was written.
+    let _hold = cancel().hold();
     let mut folder = None;
     let report = gloffuse::audit::audit(&a.options(), progress, &mut |done| {
         if let Some(dir) = &a.report {
@@ -330,6 +343,7 @@ fn audit(
         Ok(())
     })?;
     let rerun = this_command();
+    cancel().check()?;
     if let Some(dir) = &a.report {
         let folder = match folder {
             Some(f) => f,
@@ -364,6 +378,8 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     for path in [&m.junit, &m.json].into_iter().flatten() {
         check_destination(path)?;
     }
+    // As in `audit`: a stop removes the staging folder instead of ending the process in it.
+    let _hold = cancel().hold();
     let shards = m
         .shards
         .iter()
@@ -390,6 +406,7 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
             if !found && material.mean.is_some() {
                 unpictured.insert(k + 1);
             }
+            cancel().check()?;
             folder.add_copy(found.then_some(picture.as_path()))?;
         }
         for k in unpictured {
@@ -398,6 +415,7 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
                  --report DIR to have them in the merged report)"
             ));
         }
+        cancel().check()?;
         for p in folder.finish(report, &rerun)? {
             eprintln_quietly(&format!("wrote {}", p.display()));
         }

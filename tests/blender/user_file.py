@@ -2,7 +2,7 @@
 real Blender, independently of gloffuse's package.
 
     blender -b --factory-startup -noaudio --python-exit-code 1 --python user_file.py -- \
-        --make OUT.blend [--group NAME] [--texture] [--compress]
+        --make OUT.blend [--group NAME] [--texture] [--compress] [--glossy]
     blender ... --python user_file.py -- --inspect IN.blend --out RESULT.json
     python3 user_file.py ...   (bpy module)
 
@@ -10,11 +10,14 @@ real Blender, independently of gloffuse's package.
 "Chair Paint"; with --group, that material uses the user's own local node
 group NAME (a Value node "user value" = 0.123 wired to its output); with
 --texture, an Image Texture node whose image "tex" has the relative path
-//tex.png; with --compress, the file is saved compressed.
+//tex.png; with --compress, the file is saved compressed; with --glossy, its
+surface is a single-scatter GGX Glossy BSDF at roughness 1 (which an audit's
+fix replaces).
 --inspect writes what the file holds: the Blender version that saved it,
 every local node group (its gloffuse tag, its node names), every material
 with the groups its nodes use, every image's file path, the scenes' gloffuse
-tags, and the number of objects.
+tags, the number of objects, and the distribution of every BSDF node with
+one, by material.
 """
 import argparse
 import json
@@ -31,6 +34,7 @@ def args():
     parser.add_argument("--group")
     parser.add_argument("--texture", action="store_true")
     parser.add_argument("--compress", action="store_true")
+    parser.add_argument("--glossy", action="store_true")
     parser.add_argument("--inspect")
     parser.add_argument("--out")
     return parser.parse_args(argv)
@@ -50,7 +54,19 @@ def user_group(name):
     return tree
 
 
-def make(path, group, texture, compress):
+def rough_glossy(material):
+    """A single-scatter GGX Glossy BSDF at roughness 1 as the surface: it loses
+    energy in every Blender, so an audit's fix replaces it."""
+    tree = material.node_tree
+    glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
+    glossy.name = "rough glossy"
+    glossy.distribution = "GGX"
+    glossy.inputs["Roughness"].default_value = 1.0
+    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    tree.links.new(glossy.outputs[0], output.inputs["Surface"])
+
+
+def make(path, group, texture, compress, glossy):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     mesh = bpy.data.meshes.new("Cube")
     corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
@@ -62,6 +78,8 @@ def make(path, group, texture, compress):
     if material.node_tree is None:
         material.use_nodes = True
     mesh.materials.append(material)
+    if glossy:
+        rough_glossy(material)
     if group:
         node = material.node_tree.nodes.new("ShaderNodeGroup")
         node.name = "user group node"
@@ -85,7 +103,12 @@ def inspect(path, out):
                        if n.bl_idname == "ShaderNodeGroup" and n.node_tree is not None)
         for m in bpy.data.materials if m.node_tree is not None
     }
+    distributions = {
+        m.name: sorted(n.distribution for n in m.node_tree.nodes if hasattr(n, "distribution"))
+        for m in bpy.data.materials if m.node_tree is not None
+    }
     report = {
+        "distributions": distributions,
         "version": list(bpy.data.version),
         "images": {image.name: image.filepath for image in bpy.data.images},
         "groups": groups,
@@ -101,7 +124,7 @@ def main():
     options = args()
     try:
         if options.make:
-            make(options.make, options.group, options.texture, options.compress)
+            make(options.make, options.group, options.texture, options.compress, options.glossy)
         else:
             inspect(options.inspect, options.out)
     except Exception:

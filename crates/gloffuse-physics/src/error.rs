@@ -52,9 +52,36 @@ pub enum Error {
     #[error("{}", self.hint())]
     BlenderNotFound(Hint),
 
-    /// The user interrupted a Blender run (Ctrl-C): it was stopped, and nothing written.
-    #[error("interrupted: Blender was stopped and nothing was written{}", log.as_ref().map(|l| format!(" (its log: {})", l.display())).unwrap_or_default())]
-    Interrupted { log: Option<PathBuf> },
+    /// The user stopped the command (Ctrl-C, SIGTERM): Blender was stopped, temporary files
+    /// removed, and nothing written but the files in `written` (each whole, replaced before
+    /// the stop).
+    #[error("{}", interrupted_text(log.as_deref(), written))]
+    Interrupted {
+        log: Option<PathBuf>,
+        written: Vec<PathBuf>,
+    },
+}
+
+/// What a stop says: what was written before it (every such file complete), or that nothing
+/// was.
+fn interrupted_text(log: Option<&std::path::Path>, written: &[PathBuf]) -> String {
+    let log = log
+        .map(|l| format!(" (its log: {})", l.display()))
+        .unwrap_or_default();
+    if written.is_empty() {
+        return format!("interrupted: Blender was stopped and nothing was written{log}");
+    }
+    let files: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+    format!(
+        "interrupted: Blender was stopped{log}; before the stop, gloffuse had written {} \
+         (each complete; a replaced file's previous version is its .blend1): {}",
+        if written.len() == 1 {
+            "1 file".to_string()
+        } else {
+            format!("{} files", written.len())
+        },
+        files.join(", ")
+    )
 }
 
 /// A one-line message gets `; log: …; command: …` appended; a multi-line one (quoted

@@ -16,6 +16,7 @@ pub mod audit;
 pub mod bench;
 pub mod blend_file;
 pub mod blender;
+pub mod file_lock;
 pub mod fit;
 pub mod generate;
 pub mod lut;

@@ -6,19 +6,28 @@
 //!    saved it and whether it is compressed. A file saved by a newer Blender than the one
 //!    that would open it is refused (opening loses what the older one does not know)
 //!    unless a downgrade is allowed.
-//! 2. Blender opens the canonical path (every link followed), so the file's `//` relative
+//! 2. [`UserBlend::lock`] takes the lock every gloffuse writer of the file takes
+//!    (`file_lock`), waiting while another gloffuse writes it, and checks the file again:
+//!    two gloffuse runs on one file take turns, and the later one edits what the earlier
+//!    one wrote.
+//! 3. Blender opens the canonical path (every link followed), so the file's `//` relative
 //!    paths resolve from the folder the file really is in, and saves beside that real file
-//!    ([`UserBlend::temp`]), compressed exactly when the user's file is.
-//! 3. [`UserBlend::install`] gives the new file the old one's permission bits, hard-links
-//!    the old file to a temporary name beside it (a copy where links are not supported),
-//!    renames the new file over the old one and only then renames the link to
-//!    `FILE.blend1`. A failure before the main rename removes the link and leaves the file
-//!    and any earlier `.blend1` untouched; the backup is never a partial copy.
+//!    ([`LockedBlend::temp`]), compressed exactly when the user's file is.
+//! 4. [`LockedBlend::install`] refuses if the file is no longer the one Blender read
+//!    (another program saved it meanwhile), then gives the new file the old one's
+//!    permission bits, hard-links the old file to a temporary name beside it (a copy where
+//!    links are not supported), renames the new file over the old one and only then
+//!    renames the link to `FILE.blend1`. A failure before the main rename removes the link and leaves the file
+//!    and any earlier `.blend1` untouched; the backup is never a partial copy. A `.blend1`
+//!    made since the command began (another gloffuse replaced the file while this one
+//!    waited) stays: it is what the user had before either run.
 
 use std::io::Read;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
+use std::time::SystemTime;
 
+use crate::file_lock::{FileLock, Wait};
 use crate::measure::BlenderVersion;
 use crate::{Error, Field, Hint};
 
@@ -125,6 +134,36 @@ pub struct UserBlend {
     pub header: BlendHeader,
     /// Its permission bits, given to the new file.
     mode: u32,
+    /// How it was checked, so that it can be checked again under the lock.
+    field: Field,
+    blender: BlenderVersion,
+    allow_downgrade: bool,
+}
+
+/// Which file a path holds, and whether it was written since: its inode and its size and
+/// modification time. (Not the change time: linking the file as the backup changes it.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Identity {
+    dev: u64,
+    ino: u64,
+    len: u64,
+    mtime: (i64, i64),
+}
+
+impl Identity {
+    fn of(meta: &std::fs::Metadata) -> Identity {
+        use std::os::unix::fs::MetadataExt;
+        Identity {
+            dev: meta.dev(),
+            ino: meta.ino(),
+            len: meta.len(),
+            mtime: (meta.mtime(), meta.mtime_nsec()),
+        }
+    }
+
+    fn read(path: &Path) -> std::io::Result<Identity> {
+        std::fs::metadata(path).map(|m| Identity::of(&m))
+    }
 }
 
 impl UserBlend {
@@ -174,6 +213,9 @@ impl UserBlend {
             real,
             header,
             mode: meta.permissions().mode() & 0o7777,
+            field,
+            blender,
+            allow_downgrade,
         })
     }
 
@@ -189,31 +231,84 @@ impl UserBlend {
         PathBuf::from(backup)
     }
 
+    /// Takes the lock every gloffuse writer of the file takes (waiting while another
+    /// holds it), then checks the file again as [`UserBlend::open`] did: another writer may
+    /// have replaced it meanwhile. Blender must read the file only after this. `began`:
+    /// when the command began (see [`LockedBlend::install`]).
+    pub fn lock(&self, wait: &Wait, began: SystemTime) -> Result<LockedBlend, Error> {
+        let lock = FileLock::take(&self.real, wait)?;
+        let mut now = UserBlend::open(&self.real, self.field, self.blender, self.allow_downgrade)?;
+        now.given = self.given.clone();
+        let read = Identity::read(&now.real).map_err(|source| Error::Read {
+            path: now.real.clone(),
+            source,
+        })?;
+        Ok(LockedBlend {
+            blend: now,
+            read,
+            began,
+            _lock: lock,
+        })
+    }
+}
+
+/// A user's .blend under the writers' lock: what Blender reads, and the one way to replace
+/// it. The lock is released when it is dropped (after [`LockedBlend::install`]).
+#[derive(Debug)]
+pub struct LockedBlend {
+    pub blend: UserBlend,
+    /// The file as it was when the lock was taken: what Blender read.
+    read: Identity,
+    began: SystemTime,
+    _lock: FileLock,
+}
+
+impl LockedBlend {
     /// A temporary file beside the real file, for Blender to save into.
     pub fn temp(&self) -> Result<tempfile::TempPath, Error> {
-        crate::output::temp_beside(&self.real, ".blend")
+        crate::output::temp_beside(&self.blend.real, ".blend")
     }
 
     /// Puts the new file `new` (beside the real file) in place, keeping the old one as
-    /// `FILE.blend1` (see the module docs for the order). Returns the backup's path.
-    pub fn install(&self, new: tempfile::TempPath) -> Result<PathBuf, Error> {
+    /// `FILE.blend1` (see the module docs for the order), and returns the backup's path.
+    /// Refused, with nothing replaced, when the file is no longer the one Blender read
+    /// (another program saved it meanwhile). A `.blend1` made since the command began
+    /// (another gloffuse replaced the file while this one waited for the lock) stays: the
+    /// new file holds both runs' changes, and the `.blend1` what the user had before either.
+    pub fn install(self, new: tempfile::TempPath) -> Result<PathBuf, Error> {
+        let b = &self.blend;
         let fail = |path: &Path, what: &str, e: std::io::Error| Error::Write {
             path: path.to_path_buf(),
-            message: format!("{what}: {e}; {} is unchanged", self.given.display()),
+            message: format!("{what}: {e}; {} is unchanged", b.given.display()),
         };
-        std::fs::set_permissions(&new, std::fs::Permissions::from_mode(self.mode)).map_err(
-            |e| {
-                fail(
-                    &self.given,
-                    "cannot give the new file the old one's mode",
-                    e,
-                )
-            },
-        )?;
-        let backup = self.backup_path();
-        let old = self.keep_old()?;
-        std::fs::rename(&new, &self.real)
-            .map_err(|e| fail(&self.given, "cannot replace the file", e))?;
+        let now = Identity::read(&b.real).map_err(|e| {
+            fail(
+                &b.given,
+                "cannot read the file again before replacing it",
+                e,
+            )
+        })?;
+        if now != self.read {
+            return Err(Error::Write {
+                path: b.given.clone(),
+                message: "the file was changed by another program while gloffuse worked on \
+                          it; it is left as that program saved it, and gloffuse's change was \
+                          not written (run again)"
+                    .to_string(),
+            });
+        }
+        std::fs::set_permissions(&new, std::fs::Permissions::from_mode(b.mode))
+            .map_err(|e| fail(&b.given, "cannot give the new file the old one's mode", e))?;
+        let backup = b.backup_path();
+        let kept_already = std::fs::metadata(&backup).is_ok_and(|m| changed_since(&m, self.began));
+        if kept_already {
+            std::fs::rename(&new, &b.real)
+                .map_err(|e| fail(&b.given, "cannot replace the file", e))?;
+            drop(new);
+            return Ok(backup);
+        }
+        let old = b.keep_old()?;
+        std::fs::rename(&new, &b.real).map_err(|e| fail(&b.given, "cannot replace the file", e))?;
         // The new file is in place under the old name: nothing is left to clean up.
         drop(new);
         if let Err(e) = old.persist(&backup) {
@@ -226,7 +321,7 @@ impl UserBlend {
                 message: format!(
                     "{} was updated, but its previous version could not be renamed to this \
                      name ({}); it is kept as {}",
-                    self.given.display(),
+                    b.given.display(),
                     e.error,
                     kept.display()
                 ),
@@ -234,7 +329,9 @@ impl UserBlend {
         }
         Ok(backup)
     }
+}
 
+impl UserBlend {
     /// The old file under a temporary name beside it: a hard link (the very bytes, no copy
     /// to fail half-way), or a synced copy where the filesystem has no links.
     fn keep_old(&self) -> Result<tempfile::TempPath, Error> {
@@ -257,6 +354,16 @@ impl UserBlend {
         }
         Ok(slot)
     }
+}
+
+/// Whether the inode `meta` was made or renamed (its change time) at or after `when`.
+fn changed_since(meta: &std::fs::Metadata, when: SystemTime) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(since) = when.duration_since(SystemTime::UNIX_EPOCH) else {
+        return true;
+    };
+    let changed = (meta.ctime(), meta.ctime_nsec());
+    changed >= (since.as_secs() as i64, i64::from(since.subsec_nanos()))
 }
 
 /// Whether a file saved by `saved_by` is newer (by major.minor) than `blender`.

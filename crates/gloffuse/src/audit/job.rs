@@ -3,6 +3,7 @@
 //! (never saving it), applies the rules, renders each material beside its conserving twin
 //! in the white furnace and, when asked, saves a fixed copy.
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use std::collections::BTreeMap;
@@ -20,7 +21,6 @@ use crate::verify::RenderSettings;
 /// The `audit` section of the job's parameter document.
 #[derive(Clone, Debug, Serialize)]
 struct AuditSection {
-    file: String,
     output: String,
     render: bool,
     cell: u32,
@@ -29,8 +29,6 @@ struct AuditSection {
     threads: u32,
     radius_fraction: f64,
     columns: usize,
-    fix_output: Option<String>,
-    compress: bool,
     rules: Vec<RuleRange>,
     /// The gloffuse groups a twin may use, by mode and Blender distribution enum; the job
     /// asks for the ones it needs (`needs`) when the document holds no groups.
@@ -153,7 +151,8 @@ fn columns_for(cells: usize) -> usize {
 }
 
 /// Runs the audit job on `file` (its real path); with `fix_output`, the job also saves the
-/// fixed copy there (compressed when `compress`).
+/// fixed copy there (compressed when `compress`). The two paths are the job's arguments,
+/// not in the document: they reach Blender byte for byte, UTF-8 or not.
 pub fn run_job(
     s: &JobSettings,
     file: &Path,
@@ -164,7 +163,6 @@ pub fn run_job(
     let exr = run_dir.join("audit.exr");
     let render = s.render.unwrap_or_default();
     let section = AuditSection {
-        file: file.to_string_lossy().into_owned(),
         output: exr.to_string_lossy().into_owned(),
         render: s.render.is_some(),
         cell: render.cell,
@@ -174,8 +172,6 @@ pub fn run_job(
         radius_fraction: render.radius_fraction,
         // A material and its twin per material, at most.
         columns: columns_for(2 * s.materials),
-        fix_output: fix_output.map(|p| p.to_string_lossy().into_owned()),
-        compress,
         rules: ranges(),
         twin_names: TwinNames::new(),
     };
@@ -189,7 +185,7 @@ pub fn run_job(
     let run = Run {
         blender: s.blender,
         script: &script,
-        args: Vec::new(),
+        args: job_args(file, fix_output, compress),
         timeout: s.options.timeout,
         cancel: s.options.cancel.clone(),
         log: log.clone(),
@@ -202,6 +198,18 @@ pub fn run_job(
     })?;
     let exr = (s.render.is_some() && result.output.is_some()).then_some(exr);
     Ok(JobRun { result, log, exr })
+}
+
+/// The job's arguments: the file, and where its fixed copy goes.
+fn job_args(file: &Path, fix_output: Option<&Path>, compress: bool) -> Vec<OsString> {
+    let mut args = vec![OsString::from("--open"), file.as_os_str().to_owned()];
+    if let Some(out) = fix_output {
+        args.extend([OsString::from("--save"), out.as_os_str().to_owned()]);
+        if compress {
+            args.push(OsString::from("--compress"));
+        }
+    }
+    args
 }
 
 #[cfg(test)]

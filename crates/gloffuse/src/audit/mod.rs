@@ -22,13 +22,14 @@ use std::path::{Path, PathBuf};
 
 use crate::blend_file::{MATERIAL, count_blocks};
 use crate::blender::{Blender, BlenderOptions};
+use crate::file_lock::Wait;
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Engine};
 use crate::output::{check_destination, temp_beside};
 use crate::progress::Progress;
 use crate::shard::Shard;
-use crate::user_blend::{UserBlend, read_header};
+use crate::user_blend::{LockedBlend, UserBlend, read_header};
 use crate::verify::RenderSettings;
 use crate::verify::image::{Rgba, read_rgba};
 use crate::{Error, Field, Hint};
@@ -114,6 +115,7 @@ fn checked_files(o: &AuditOptions) -> Result<Vec<PathBuf>, Error> {
     check(o)?;
     let files = files::blend_files(&o.paths)?;
     check_fix_inputs(o, &files)?;
+    check_fix_dir_names(o, &files)?;
     Ok(files)
 }
 
@@ -124,19 +126,9 @@ fn audit_files(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    let counts: Vec<usize> = files
-        .iter()
-        .map(|f| count_blocks(f, MATERIAL).unwrap_or(1))
-        .collect();
     let mut report = empty_report(o, blender);
-    let (files, counts) = match o.shard {
-        None => (files.to_vec(), counts),
-        Some(shard) => {
-            report.shard = Some(shard_run(shard, files, &counts));
-            shard_part(shard, files, counts)
-        }
-    };
-    let fix_targets = fix_targets(o, &files, blender)?;
+    let (files, counts) = files_to_audit(o, files, &mut report);
+    let fix_targets = fix_targets(o, &files, blender);
     let mut twins = TwinGroups::new(blender);
     let mut predictor = Predictor::new(blender.version);
     let total: usize = counts.iter().sum();
@@ -148,8 +140,19 @@ fn audit_files(
         ),
         total as u64,
     );
+    // Fixes make files beside the user's and replace them: a stop waits for the next check
+    // (between files, before a replacement), and then says what was written.
+    let _hold = o.blender.cancel.hold();
+    let mut written: Vec<PathBuf> = Vec::new();
+    let stopped = |e: Error, before: &[PathBuf]| match e {
+        Error::Interrupted { log, written } => Error::Interrupted {
+            log,
+            written: [before, &written].concat(),
+        },
+        other => other,
+    };
     let mut done = 0u64;
-    for ((file, materials), fix) in files.iter().zip(&counts).zip(&fix_targets) {
+    for ((file, materials), fix) in files.iter().zip(&counts).zip(fix_targets) {
         let settings = JobSettings {
             blender,
             options: &o.blender,
@@ -158,36 +161,31 @@ fn audit_files(
             materials: *materials,
             on_fraction: &|f: f64| progress.set(done + (f.min(1.0) * *materials as f64) as u64),
         };
-        let (mut audited_file, mut materials_done, image) =
-            match audit_file(&settings, &mut twins, file, fix.as_ref(), o, &mut predictor) {
-                Err(e @ Error::Interrupted { .. }) => {
-                    progress.end();
-                    return Err(e);
-                }
-                Err(e) => (failed_file(file, &e), Vec::new(), None),
-                Ok(ok) => ok,
-            };
-        if let Some(fixed) = &mut audited_file.fixed {
-            match after(
+        let step = o.blender.cancel.check().and_then(|()| {
+            let audited = audit_one(
                 &settings,
                 &mut twins,
-                Path::new(&fixed.path),
+                file,
+                fix,
                 o,
                 &mut predictor,
-            ) {
-                Err(e @ Error::Interrupted { .. }) => {
-                    progress.end();
-                    return Err(e);
-                }
-                Err(e) => fixed.after_error = Some(e.to_string()),
-                Ok(after) => attach_after(&mut materials_done, after),
+                progress,
+            )?;
+            written.extend(audited.3.clone());
+            on_file(FileDone {
+                file: &audited.0,
+                materials: &audited.1,
+                image: audited.2.as_ref(),
+            })?;
+            Ok(audited)
+        });
+        let (audited_file, materials_done, _, _) = match step {
+            Ok(audited) => audited,
+            Err(e) => {
+                progress.end();
+                return Err(stopped(e, &written));
             }
-        }
-        on_file(FileDone {
-            file: &audited_file,
-            materials: &materials_done,
-            image: image.as_ref(),
-        })?;
+        };
         report.files.push(audited_file);
         report.materials.extend(materials_done);
         done += *materials as u64;
@@ -196,6 +194,60 @@ fn audit_files(
     progress.end();
     report.finish();
     Ok(report)
+}
+
+/// The files this run audits (its shard's, when sharded) and their material counts; a
+/// shard's place in the whole run goes into `report`.
+fn files_to_audit(
+    o: &AuditOptions,
+    files: &[PathBuf],
+    report: &mut AuditReport,
+) -> (Vec<PathBuf>, Vec<usize>) {
+    let counts: Vec<usize> = files
+        .iter()
+        .map(|f| count_blocks(f, MATERIAL).unwrap_or(1))
+        .collect();
+    match o.shard {
+        None => (files.to_vec(), counts),
+        Some(shard) => {
+            report.shard = Some(shard_run(shard, files, &counts));
+            shard_part(shard, files, counts)
+        }
+    }
+}
+
+/// One file audited, its fix installed and the fixed file audited again, when asked. An
+/// error of the file's own becomes its entry; a stop (`Error::Interrupted`) is returned.
+fn audit_one(
+    settings: &JobSettings,
+    twins: &mut TwinGroups,
+    file: &Path,
+    fix: Result<Option<FixPlan>, Error>,
+    o: &AuditOptions,
+    predictor: &mut Predictor,
+    progress: &dyn Progress,
+) -> Result<FileAudit, Error> {
+    let audited =
+        fix.and_then(|fix| audit_file(settings, twins, file, fix.as_ref(), o, predictor, progress));
+    let (mut audited_file, mut materials, image, installed) = match audited {
+        Err(e @ Error::Interrupted { .. }) => return Err(e),
+        Err(e) => (failed_file(file, &e), Vec::new(), None, None),
+        Ok(ok) => ok,
+    };
+    if let (Some(fixed), Some(installed)) = (&mut audited_file.fixed, &installed) {
+        match after(settings, twins, installed, o, predictor) {
+            // Stopped after the fix was installed: it counts as written.
+            Err(Error::Interrupted { log, .. }) => {
+                return Err(Error::Interrupted {
+                    log,
+                    written: vec![installed.clone()],
+                });
+            }
+            Err(e) => fixed.after_error = Some(e.to_string()),
+            Ok(after) => attach_after(&mut materials, after),
+        }
+    }
+    Ok((audited_file, materials, image, installed))
 }
 
 /// What a Blender start costs, in materials' audit time: the split balances each file's
@@ -295,23 +347,55 @@ fn check_fix_inputs(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
     }
 }
 
+/// `--fix-dir` writes each input under its path relative to the folder it was found in:
+/// two inputs that would land on one path (`a/x.blend b/x.blend`) are refused, naming both,
+/// rather than one fixed copy silently replacing the other.
+fn check_fix_dir_names(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
+    let FixTarget::Dir(dir) = &o.fix else {
+        return Ok(());
+    };
+    let mut seen: std::collections::BTreeMap<PathBuf, &PathBuf> = Default::default();
+    for file in files {
+        let relative = relative_to_root(file, &o.paths);
+        if let Some(first) = seen.insert(relative.clone(), file) {
+            return Err(Error::input(
+                Field::FixDir,
+                dir.display(),
+                Hint::text(format!(
+                    "a folder where each input's fixed copy has a path of its own: {} and {} \
+                     would both be written to {} (audit them in two runs, or name the folders \
+                     that hold them so that their paths below those folders differ)",
+                    first.display(),
+                    file.display(),
+                    dir.join(&relative).display()
+                )),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// How one file's fix is written.
 struct FixPlan {
     /// The input, checked (its header: version and compression).
     input: UserBlend,
     /// Where the fixed file goes; `None`: the input itself.
     dest: Option<PathBuf>,
+    /// When the audit began: a `.blend1` made since then is another gloffuse's, kept.
+    began: std::time::SystemTime,
 }
 
-/// Each file's fix plan, checked before any render: one input for `--fix`, never the input
-/// itself as a copy, and no file saved by a newer Blender unless a downgrade is allowed.
+/// Each file's fix plan, checked before any render: never the input itself as a copy, and
+/// no file saved by a newer Blender unless a downgrade is allowed. A file that cannot be
+/// fixed is that file's error: the others are audited and fixed all the same.
 fn fix_targets(
     o: &AuditOptions,
     files: &[PathBuf],
     blender: &Blender,
-) -> Result<Vec<Option<FixPlan>>, Error> {
+) -> Vec<Result<Option<FixPlan>, Error>> {
+    let began = std::time::SystemTime::now();
     let field = match &o.fix {
-        FixTarget::None => return Ok(files.iter().map(|_| None).collect()),
+        FixTarget::None => return files.iter().map(|_| Ok(None)).collect(),
         FixTarget::File(_) => Field::Fix,
         FixTarget::Dir(_) => Field::FixDir,
         FixTarget::InPlace => Field::InPlace,
@@ -337,7 +421,7 @@ fn fix_targets(
                     ),
                 ));
             }
-            Ok(Some(FixPlan { input, dest }))
+            Ok(Some(FixPlan { input, dest, began }))
         })
         .collect()
 }
@@ -451,7 +535,13 @@ fn run_twinned(
     }
 }
 
-type FileAudit = (AuditedFile, Vec<AuditedMaterial>, Option<Rgba>);
+/// A file's entry, its materials, its grid, and the path its fix was installed at.
+type FileAudit = (
+    AuditedFile,
+    Vec<AuditedMaterial>,
+    Option<Rgba>,
+    Option<PathBuf>,
+);
 
 fn audit_file(
     s: &JobSettings,
@@ -460,14 +550,30 @@ fn audit_file(
     fix: Option<&FixPlan>,
     o: &AuditOptions,
     predictor: &mut Predictor,
+    progress: &dyn Progress,
 ) -> Result<FileAudit, Error> {
     let real = std::fs::canonicalize(file).map_err(|source| Error::Read {
         path: file.to_path_buf(),
         source,
     })?;
-    let temp = match fix {
-        None => None,
-        Some(FixPlan { input, dest: None }) => Some(input.temp()?),
+    // The file itself is replaced: its writers' lock is held from before Blender reads it
+    // until it is replaced.
+    let wait = Wait {
+        limit: None,
+        cancel: &o.blender.cancel,
+        progress: Some(progress),
+    };
+    let (target, temp) = match fix {
+        None => (None, None),
+        Some(FixPlan {
+            input,
+            dest: None,
+            began,
+        }) => {
+            let locked = input.lock(&wait, *began)?;
+            let temp = locked.temp()?;
+            (Some(Installing::InPlace(locked)), Some(temp))
+        }
         Some(FixPlan {
             dest: Some(dest), ..
         }) => {
@@ -477,18 +583,25 @@ fn audit_file(
                     message: e.to_string(),
                 })?;
             }
-            Some(temp_beside(dest, ".blend")?)
+            (
+                Some(Installing::Copy(dest)),
+                Some(temp_beside(dest, ".blend")?),
+            )
         }
     };
     let compress = fix.is_some_and(|f| f.input.compressed());
     let job = run_twinned(s, twins, &real, temp.as_deref(), compress)?;
     let image = job.exr.as_deref().map(read_grid).transpose()?;
-    let (file_entry, materials) = judged(file, &job, image.as_ref(), o, predictor);
-    let mut file_entry = file_entry;
-    if let (Some(fix), Some(temp), Some(fixed)) = (fix, temp, &job.result.fixed) {
-        file_entry.fixed = install_fix(fix, temp, fixed.replaced)?;
+    let (mut file_entry, materials) = judged(file, &job, image.as_ref(), o, predictor);
+    let mut installed = None;
+    if let (Some(target), Some(temp), Some(fixed)) = (target, temp, &job.result.fixed) {
+        o.blender.cancel.check()?;
+        if let Some((entry, path)) = install_fix(target, temp, fixed.replaced)? {
+            file_entry.fixed = Some(entry);
+            installed = Some(path);
+        }
     }
-    Ok((file_entry, materials, image))
+    Ok((file_entry, materials, image, installed))
 }
 
 fn read_grid(exr: &Path) -> Result<Rgba, Error> {
@@ -545,38 +658,44 @@ fn judged(
     (entry, materials)
 }
 
+/// Where a fixed file goes.
+enum Installing<'a> {
+    /// Over the input itself, under its writers' lock.
+    InPlace(LockedBlend),
+    /// A copy at this path.
+    Copy(&'a Path),
+}
+
 /// Puts a fixed file in place: a copy renamed to its destination, or the input replaced
-/// through `UserBlend::install` (its previous version kept as `.blend1`). An in-place fix
-/// that replaced nothing leaves the file alone.
+/// through `LockedBlend::install` (its previous version kept as `.blend1`). An in-place fix
+/// that replaced nothing leaves the file alone. Returns the entry and the path installed.
 fn install_fix(
-    fix: &FixPlan,
+    target: Installing,
     temp: tempfile::TempPath,
     replaced: usize,
-) -> Result<Option<Fixed>, Error> {
-    match &fix.dest {
-        None if replaced == 0 => Ok(None),
-        None => {
-            let backup = fix.input.install(temp)?;
-            Ok(Some(Fixed {
-                path: fix.input.real.display().to_string(),
-                replaced,
-                backup: Some(backup.display().to_string()),
-                after_error: None,
-            }))
+) -> Result<Option<(Fixed, PathBuf)>, Error> {
+    let (path, backup) = match target {
+        Installing::InPlace(_) if replaced == 0 => return Ok(None),
+        Installing::InPlace(locked) => {
+            let real = locked.blend.real.clone();
+            let backup = locked.install(temp)?;
+            (real, Some(backup.display().to_string()))
         }
-        Some(dest) => {
+        Installing::Copy(dest) => {
             temp.persist(dest).map_err(|e| Error::Write {
-                path: dest.clone(),
+                path: dest.to_path_buf(),
                 message: e.error.to_string(),
             })?;
-            Ok(Some(Fixed {
-                path: dest.display().to_string(),
-                replaced,
-                backup: None,
-                after_error: None,
-            }))
+            (dest.to_path_buf(), None)
         }
-    }
+    };
+    let fixed = Fixed {
+        path: path.display().to_string(),
+        replaced,
+        backup,
+        after_error: None,
+    };
+    Ok(Some((fixed, path)))
 }
 
 /// The fixed file audited again.

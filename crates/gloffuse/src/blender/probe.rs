@@ -351,7 +351,10 @@ fn run_probe(argv: &[OsString], deadline: Instant, cancel: &Cancel) -> Result<Ra
         }
     };
     match exit {
-        Exit::Interrupted => Err(Error::Interrupted { log: None }),
+        Exit::Interrupted => Err(Error::Interrupted {
+            log: None,
+            written: Vec::new(),
+        }),
         Exit::TimedOut => {
             let within = format!("did not answer within {} s", format_seconds(timeout));
             let outcome = if timeout < PROBE_TIMEOUT {

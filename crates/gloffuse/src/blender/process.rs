@@ -19,21 +19,52 @@ pub struct Cancel(Arc<CancelState>);
 #[derive(Debug, Default)]
 struct CancelState {
     requested: AtomicBool,
-    /// How many [`run_logged`] calls are waiting for a child right now.
-    waiting: AtomicUsize,
+    /// How many [`run_logged`] calls are waiting for a child, and [`Hold`]s are alive,
+    /// right now: each will notice a request.
+    listening: AtomicUsize,
 }
 
 impl Cancel {
     /// Asks every child being waited for to be stopped: their waits kill the process group
-    /// and return [`Exit::Interrupted`], and so does every later run. False when no child is
-    /// waited for (the caller may then end at once). Only atomics: safe in a signal handler.
+    /// and return [`Exit::Interrupted`], and so does every later run, and every [`Cancel::check`].
+    /// False when nothing listens (no child waited for, no [`Hold`]: the caller may then end
+    /// at once). Only atomics: safe in a signal handler.
     pub fn request(&self) -> bool {
         self.0.requested.store(true, Ordering::SeqCst);
-        self.0.waiting.load(Ordering::SeqCst) > 0
+        self.0.listening.load(Ordering::SeqCst) > 0
     }
 
     pub fn is_requested(&self) -> bool {
         self.0.requested.load(Ordering::SeqCst)
+    }
+
+    /// Makes a request wait for the holder's next [`Cancel::check`] while the guard lives:
+    /// held around work that has temporary files beside a user's (or already replaced some),
+    /// so a stop removes them and says what was written instead of ending the process there.
+    pub fn hold(&self) -> Hold {
+        self.0.listening.fetch_add(1, Ordering::SeqCst);
+        Hold(self.clone())
+    }
+
+    /// `Err(Interrupted)` once a stop was requested: called between steps of held work.
+    pub fn check(&self) -> Result<(), crate::Error> {
+        if self.is_requested() {
+            return Err(crate::Error::Interrupted {
+                log: None,
+                written: Vec::new(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// See [`Cancel::hold`].
+#[derive(Debug)]
+pub struct Hold(Cancel);
+
+impl Drop for Hold {
+    fn drop(&mut self) {
+        self.0.0.listening.fetch_sub(1, Ordering::SeqCst);
     }
 }
 
@@ -49,14 +80,14 @@ struct Waiting<'a>(&'a Cancel);
 
 impl<'a> Waiting<'a> {
     fn new(cancel: &'a Cancel) -> Self {
-        cancel.0.waiting.fetch_add(1, Ordering::SeqCst);
+        cancel.0.listening.fetch_add(1, Ordering::SeqCst);
         Waiting(cancel)
     }
 }
 
 impl Drop for Waiting<'_> {
     fn drop(&mut self) {
-        self.0.0.waiting.fetch_sub(1, Ordering::SeqCst);
+        self.0.0.listening.fetch_sub(1, Ordering::SeqCst);
     }
 }
 
@@ -110,6 +141,10 @@ pub fn run_logged(
         .process_group(0);
     die_with_parent(&mut cmd);
     let _waiting = Waiting::new(cancel);
+    // A stop asked for before the start: no Blender is started for nothing.
+    if cancel.is_requested() {
+        return Ok(Exit::Interrupted);
+    }
     let mut child = cmd.spawn()?;
     wait_for(&mut child, timeout, cancel)
 }

@@ -117,6 +117,7 @@ pub fn run_script(run: &Run) -> Result<RunOutput, Error> {
         Exit::Interrupted => {
             return Err(Error::Interrupted {
                 log: Some(run.log.clone()),
+                written: Vec::new(),
             });
         }
         Exit::TimedOut => {

@@ -11,14 +11,15 @@
 //! before the Blender run (bad input fails fast, and the groups get the user's ids), and
 //! again under a lock just before it is replaced, so catalogs added meanwhile are kept.
 
-use std::fs::File;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use serde::Serialize;
 use uuid::Uuid;
 
+use crate::blender::Cancel;
 use crate::error::{Error, Field, Hint};
+use crate::file_lock::{FileLock, Wait};
 use crate::output::staged;
 
 /// The name of Blender's catalog definition file, beside the .blend (the library root).
@@ -190,13 +191,20 @@ impl Catalogs {
 pub struct Staged {
     file: PathBuf,
     tmp: tempfile::TempPath,
-    _lock: Lock,
+    _lock: FileLock,
 }
 
 /// Re-reads the definition file `file` under its lock, merges the catalogs `ours` (already
 /// resolved against the file as it was before the run) into it, and stages the result.
 pub fn stage(file: &Path, ours: &Catalogs) -> Result<Staged, Error> {
-    let lock = Lock::take(file)?;
+    let lock = FileLock::take(
+        file,
+        &Wait {
+            limit: Some(LOCK_WAIT),
+            cancel: &Cancel::default(),
+            progress: None,
+        },
+    )?;
     let existing = read(file)?;
     let (_, text) = ours.merge(existing.as_deref());
     let tmp = staged(file, text.as_bytes())?;
@@ -219,67 +227,9 @@ impl Staged {
     }
 }
 
-/// An advisory lock (`flock`) on a hidden file beside the definition file, held while it is
-/// re-read, merged and replaced, so two gloffuse runs never lose each other's catalogs.
-/// The lock file is removed while still locked; a waiter that then wins a removed file
-/// sees that it no longer has the path and locks again.
-struct Lock {
-    path: PathBuf,
-    _file: File,
-}
-
-/// How long to wait for another run's lock (it holds it for a merge and a rename).
+/// How long to wait for another run's lock on the definition file (it holds it for a
+/// merge and a rename).
 const LOCK_WAIT: Duration = Duration::from_secs(30);
-
-impl Lock {
-    fn take(file: &Path) -> Result<Lock, Error> {
-        use std::os::unix::fs::MetadataExt;
-        let name = format!(".{FILE_NAME}.gloffuse-lock");
-        let path = file.parent().unwrap_or(Path::new(".")).join(name);
-        let fail = |message: String| Error::Write {
-            path: path.clone(),
-            message,
-        };
-        let start = Instant::now();
-        loop {
-            let handle = std::fs::OpenOptions::new()
-                .create(true)
-                .truncate(false)
-                .write(true)
-                .open(&path)
-                .map_err(|e| fail(e.to_string()))?;
-            match handle.try_lock() {
-                Ok(()) => {
-                    let held = handle.metadata().map_err(|e| fail(e.to_string()))?;
-                    let current = std::fs::metadata(&path);
-                    if current.is_ok_and(|m| m.ino() == held.ino() && m.dev() == held.dev()) {
-                        return Ok(Lock {
-                            path,
-                            _file: handle,
-                        });
-                    }
-                }
-                Err(std::fs::TryLockError::WouldBlock) => {}
-                Err(std::fs::TryLockError::Error(e)) => return Err(fail(e.to_string())),
-            }
-            if start.elapsed() > LOCK_WAIT {
-                return Err(fail(format!(
-                    "another process has held this lock for over {} s; if none is running, \
-                     remove the file",
-                    LOCK_WAIT.as_secs()
-                )));
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-}
-
-impl Drop for Lock {
-    fn drop(&mut self) {
-        // Removed before the handle (and so the lock) is released: see `Lock`.
-        let _ = std::fs::remove_file(&self.path);
-    }
-}
 
 /// The opening of a new definition file, as Blender writes it.
 const HEADER: &str = "# This is an Asset Catalog Definition file for Blender.\n#\n\
@@ -410,7 +360,7 @@ mod tests {
         let first = stage(&file, &ours).unwrap();
         let (file2, ours2) = (file.clone(), ours.clone());
         let waiter = std::thread::spawn(move || {
-            let started = Instant::now();
+            let started = std::time::Instant::now();
             let second = stage(&file2, &ours2).unwrap();
             (started.elapsed(), second.commit().unwrap())
         });

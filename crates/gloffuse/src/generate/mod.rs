@@ -22,11 +22,12 @@ use std::path::{Path, PathBuf};
 
 use crate::blender::{Blender, BlenderOptions, Run, RunOutput, command_line, run_following_steps};
 use crate::error::{Error, Field, Hint};
+use crate::file_lock::{FileLock, Wait};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
 use crate::output::{Destination, check_destination, temp_beside, write_output};
 use crate::progress::Progress;
-use crate::user_blend::{UserBlend, read_header};
+use crate::user_blend::{LockedBlend, UserBlend, read_header};
 use blend::incomplete_blend;
 
 /// What `generate` writes, and from what.
@@ -206,6 +207,7 @@ fn engines_of(
 
 /// Writes what `g` asks for; nothing is written if anything fails.
 pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generated, Error> {
+    let began = std::time::SystemTime::now();
     // Inputs and coefficients are checked before Blender is looked for: bad input fails fast.
     check_inputs(g)?;
     check_library(g)?;
@@ -243,7 +245,11 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         .as_deref()
         .map(|into| UserBlend::open(into, Field::Into, blender.version, g.allow_downgrade))
         .transpose()?;
-    let built = run_blender(g, &blender, &script, user_blend.as_ref(), progress)?;
+    // From here files are made beside the user's: a stop waits for the next check, which
+    // removes them (see `Cancel::hold`).
+    let _hold = g.blender.cancel.hold();
+    let (locked, _library_lock) = writers_locks(g, user_blend, began, progress)?;
+    let built = run_blender(g, &blender, &script, locked.as_ref(), progress)?;
     out.log = Some(built.log.clone());
     out.renamed = built.renamed.clone();
     if let Some(groups) = &built.groups {
@@ -260,11 +266,46 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         write_output(zip, bytes)?;
         out.extension = Some(zip.clone());
     }
-    install_blend(built, user_blend.as_ref(), &mut out)?;
+    g.blender.cancel.check()?;
+    // The library and its catalogs change together or not at all: the library's previous
+    // version is kept until the catalog file is in place, and put back if it cannot be.
+    let previous = install_blend(built, locked, &mut out)?;
     if let Some(staged) = catalogs {
-        out.catalogs = Some(staged.commit()?);
+        match staged.commit() {
+            Ok(file) => out.catalogs = Some(file),
+            Err(e) => {
+                return Err(match previous.map(Previous::restore).transpose() {
+                    Ok(_) => e,
+                    Err(restore) => restore,
+                });
+            }
+        }
     }
     Ok(out)
+}
+
+/// The lock of every file `g` replaces, taken before Blender reads it (waiting, and saying
+/// so, while another gloffuse writes it): the user's file (`into`, checked again under the
+/// lock), or the library `blend` replaces.
+fn writers_locks(
+    g: &GenerateOptions,
+    user_blend: Option<UserBlend>,
+    began: std::time::SystemTime,
+    progress: &dyn Progress,
+) -> Result<(Option<LockedBlend>, Option<FileLock>), Error> {
+    let wait = Wait {
+        limit: None,
+        cancel: &g.blender.cancel,
+        progress: Some(progress),
+    };
+    if let Some(user_blend) = user_blend {
+        return Ok((Some(user_blend.lock(&wait, began)?), None));
+    }
+    let library = match g.blend.as_deref().map(check_destination).transpose()? {
+        Some(Destination::File(real)) => Some(FileLock::take(&real, &wait)?),
+        _ => None,
+    };
+    Ok((None, library))
 }
 
 /// The coefficients `g` pins, with the name they were given by.
@@ -413,7 +454,7 @@ fn run_blender(
     g: &GenerateOptions,
     blender: &Blender,
     script: &str,
-    user_blend: Option<&UserBlend>,
+    user_blend: Option<&LockedBlend>,
     progress: &dyn Progress,
 ) -> Result<Built, Error> {
     let run_dir = crate::blender::runs::new_run_dir("generate")?;
@@ -437,9 +478,9 @@ fn run_blender(
     if let Some(user_blend) = user_blend {
         args.extend([
             OsString::from("--open"),
-            user_blend.real.clone().into_os_string(),
+            user_blend.blend.real.clone().into_os_string(),
         ]);
-        if user_blend.compressed() {
+        if user_blend.blend.compressed() {
             args.push(OsString::from("--compress"));
         }
     }
@@ -559,38 +600,91 @@ fn package_extension(
 
 /// Puts the saved .blend in its destination, if it has one: the user's file replaced the
 /// safe way (its previous version kept as .blend1), a new file renamed into place, or the
-/// bytes copied to a stream.
+/// bytes copied to a stream. A file replaced in place returns what it replaced, so that
+/// the caller can put it back (until dropped).
 fn install_blend(
     built: Built,
-    user_blend: Option<&UserBlend>,
+    user_blend: Option<LockedBlend>,
     out: &mut Generated,
-) -> Result<(), Error> {
+) -> Result<Option<Previous>, Error> {
     let Built {
         tmp, dest, target, ..
     } = built;
     let Some(dest) = dest else {
-        return Ok(());
+        return Ok(None);
     };
     if let Some(user_blend) = user_blend {
         out.backup = Some(user_blend.install(tmp)?);
         out.blend = Some(dest);
-        return Ok(());
+        return Ok(None);
     }
-    match &target {
-        Destination::File(real) => tmp.persist(real).map_err(|e| Error::Write {
-            path: dest.clone(),
-            message: e.error.to_string(),
-        })?,
+    let previous = match &target {
+        Destination::File(real) => {
+            let previous = Previous::keep(real)?;
+            tmp.persist(real).map_err(|e| Error::Write {
+                path: dest.clone(),
+                message: e.error.to_string(),
+            })?;
+            Some(previous)
+        }
         Destination::Stream(_) | Destination::Stdout => {
             let bytes = std::fs::read(&tmp).map_err(|source| Error::Read {
                 path: tmp.to_path_buf(),
                 source,
             })?;
             write_output(&dest, &bytes)?;
+            None
+        }
+    };
+    out.blend = Some(dest);
+    Ok(previous)
+}
+
+/// A file about to be replaced, kept under a temporary name beside it (a hard link: the
+/// very bytes) until dropped, so that [`Previous::restore`] can undo the replacement.
+struct Previous {
+    real: PathBuf,
+    /// `None`: there was no file.
+    link: Option<tempfile::TempPath>,
+}
+
+impl Previous {
+    fn keep(real: &Path) -> Result<Previous, Error> {
+        if !real.exists() {
+            return Ok(Previous {
+                real: real.to_path_buf(),
+                link: None,
+            });
+        }
+        let slot = temp_beside(real, ".blend")?;
+        let fail = |e: std::io::Error| Error::Write {
+            path: real.to_path_buf(),
+            message: format!("cannot keep the previous version while it is replaced: {e}"),
+        };
+        std::fs::remove_file(&slot).map_err(fail)?;
+        if std::fs::hard_link(real, &slot).is_err() {
+            std::fs::copy(real, &slot).map_err(fail)?;
+        }
+        Ok(Previous {
+            real: real.to_path_buf(),
+            link: Some(slot),
+        })
+    }
+
+    /// Puts the previous version back (or removes the new file, where there was none).
+    fn restore(self) -> Result<(), Error> {
+        let fail = |e: std::io::Error| Error::Write {
+            path: self.real.clone(),
+            message: format!("cannot put the previous version back: {e}"),
+        };
+        match self.link {
+            Some(link) => link
+                .persist(&self.real)
+                .map(drop)
+                .map_err(|e| fail(e.error)),
+            None => std::fs::remove_file(&self.real).map_err(fail),
         }
     }
-    out.blend = Some(dest);
-    Ok(())
 }
 
 /// Where the catalog definition file of the library `blend` lives: beside the file it

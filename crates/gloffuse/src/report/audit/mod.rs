@@ -20,10 +20,13 @@ const PICTURES: &str = "materials";
 
 /// The report folder while the audit runs: each file's pictures are written as it is done,
 /// into a temporary folder inside it that becomes `materials/` when the report is finished
-/// (an audit stopped half-way leaves no pictures behind).
+/// (an audit stopped half-way leaves no pictures behind, and no report folder it made).
 pub struct ReportDir {
     dir: PathBuf,
-    staging: tempfile::TempDir,
+    /// Whether this run made `dir` (then an unfinished report removes it again).
+    made: bool,
+    /// Taken by [`ReportDir::finish`]; still here when dropped unfinished.
+    staging: Option<tempfile::TempDir>,
     /// Per material, in report order: its picture's path relative to the folder, if rendered.
     pictures: Vec<Option<String>>,
 }
@@ -31,6 +34,7 @@ pub struct ReportDir {
 impl ReportDir {
     /// Makes `dir` (its parent must exist) and the temporary picture folder in it.
     pub fn create(dir: &Path) -> Result<Self, Error> {
+        let made = !dir.exists();
         output::make_report_dir(dir)?;
         let staging = tempfile::Builder::new()
             .prefix(".gloffuse-materials-")
@@ -41,9 +45,14 @@ impl ReportDir {
             })?;
         Ok(ReportDir {
             dir: dir.to_path_buf(),
-            staging,
+            made,
+            staging: Some(staging),
             pictures: Vec::new(),
         })
+    }
+
+    fn staging(&self) -> &Path {
+        self.staging.as_ref().expect("taken only by finish").path()
     }
 
     /// Writes one PNG per rendered material of `done`: as authored | twin | difference.
@@ -52,7 +61,7 @@ impl ReportDir {
             let picture = match (done.image, done.file.grid, m.cells) {
                 (Some(image), Some((columns, cell)), Some((own, twin))) => {
                     let file = picture_name(self.pictures.len());
-                    let path = self.staging.path().join(&file);
+                    let path = self.staging().join(&file);
                     let rgb = strip(image, columns, cell, own, twin);
                     let bytes =
                         encode_png(&rgb, ((3 * cell) as u32, cell as u32)).map_err(|message| {
@@ -76,7 +85,7 @@ impl ReportDir {
         let picture = match from {
             Some(from) => {
                 let file = picture_name(self.pictures.len());
-                let path = self.staging.path().join(&file);
+                let path = self.staging().join(&file);
                 std::fs::copy(from, &path).map_err(|e| Error::Write {
                     path: path.clone(),
                     message: format!("copying {}: {e}", from.display()),
@@ -91,13 +100,13 @@ impl ReportDir {
 
     /// Puts the pictures in place as `materials/` (replacing an earlier report's), writes
     /// report.json and report.html; returns every path written at the top.
-    pub fn finish(self, report: &AuditReport, rerun: &str) -> Result<Vec<PathBuf>, Error> {
+    pub fn finish(mut self, report: &AuditReport, rerun: &str) -> Result<Vec<PathBuf>, Error> {
         let pictures = self.dir.join(PICTURES);
         let fail = |e: std::io::Error| Error::Write {
             path: pictures.clone(),
             message: e.to_string(),
         };
-        let staged = self.staging.keep();
+        let staged = self.staging.take().expect("taken only here").keep();
         if pictures.is_dir() {
             // The old folder moves aside, the new one takes its name, then the old goes.
             let old = staged.with_extension("old");
@@ -116,6 +125,19 @@ impl ReportDir {
             html::render(report, &self.pictures, rerun).as_bytes(),
         )?;
         Ok(vec![json, page, self.dir.join(PICTURES)])
+    }
+}
+
+impl Drop for ReportDir {
+    /// Unfinished (an error, a stop): the pictures go, and the folder too if this run made
+    /// it and nothing else is in it.
+    fn drop(&mut self) {
+        if let Some(staging) = self.staging.take() {
+            drop(staging);
+            if self.made {
+                let _ = std::fs::remove_dir(&self.dir);
+            }
+        }
     }
 }
 
