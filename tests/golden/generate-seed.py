@@ -2778,6 +2778,7 @@ def sphere_mesh(name, radius, segments, rings, cut_below=None):
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
 #   open_blend(path), save_blend(path, compress) -> absolute path
 #   result_line(payload) -> "GLOFFUSE_RESULT {...}"
+#   shown_path(path) -> the path as UTF-8 text (bad bytes shown as U+FFFD)
 #   run_main(main) -> runs main with the error handling described there, and
 #       ends the process when main is done (see end_process)
 # ---------------------------------------------------------------------------
@@ -2857,6 +2858,12 @@ def save_blend(path, compress=False):
     if "FINISHED" not in result or not os.path.isfile(path):
         raise RuntimeError("Blender could not save %s" % path)
     return path
+
+
+def shown_path(path):
+    """`path` as text for the result line: a name that is not UTF-8 (surrogate-escaped in
+    Python) shows U+FFFD where its bad bytes are, as JSON can hold no lone surrogate."""
+    return os.fsencode(path).decode("utf-8", "replace")
 
 
 def result_line(payload):
