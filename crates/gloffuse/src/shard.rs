@@ -4,7 +4,7 @@
 //! its own part: no queue, no coordinator.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
@@ -128,32 +128,38 @@ pub fn in_order<T>(shards: Vec<(PathBuf, Option<Shard>, T)>) -> Result<Vec<(Path
         placed.insert(shard.index, (path, report));
     }
     if placed.len() < count {
-        // At most the first few missing, found in as many steps as there are reports.
-        const SHOWN: usize = 10;
-        let mut missing: Vec<String> = (1..=count)
-            .filter(|k| !placed.contains_key(k))
-            .take(SHOWN)
-            .map(|k| format!("{k}/{count}"))
-            .collect();
-        let more = count - placed.len() - missing.len();
-        if more > 0 {
-            missing.push(format!("and {more} more"));
-        }
-        return Err(Error::input(
-            Field::ShardReport,
-            format!("{} reports", placed.len()),
-            Hint::new(
-                format!(
-                    "every shard of {count}, as {} says: missing {} (its report.json or {{}} \
-                     folder)",
-                    first.display(),
-                    missing.join(", ")
-                ),
-                [Field::Report],
-            ),
-        ));
+        return Err(missing(count, &placed, &first));
     }
     Ok(placed.into_values().collect())
+}
+
+/// The error of shards of `count` of which only those `placed` were given, `first` the
+/// report that gives the count: the first few missing, found in as many steps as there are
+/// reports (a count may be 10¹⁵).
+fn missing<T>(count: usize, placed: &BTreeMap<usize, T>, first: &Path) -> Error {
+    const SHOWN: usize = 10;
+    let mut missing: Vec<String> = (1..=count)
+        .filter(|k| !placed.contains_key(k))
+        .take(SHOWN)
+        .map(|k| format!("{k}/{count}"))
+        .collect();
+    let more = count - placed.len() - missing.len();
+    if more > 0 {
+        missing.push(format!("and {more} more"));
+    }
+    Error::input(
+        Field::ShardReport,
+        format!("{} reports", placed.len()),
+        Hint::new(
+            format!(
+                "every shard of {count}, as {} says: missing {} (its report.json or {{}} \
+                 folder)",
+                first.display(),
+                missing.join(", ")
+            ),
+            [Field::Report],
+        ),
+    )
 }
 
 #[cfg(test)]
