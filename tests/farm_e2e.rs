@@ -371,6 +371,77 @@ fn slurm_runs_the_shards_then_the_merge() {
     assert_eq!(count(job.join("merged/materials")), count(local));
 }
 
+/// A job folder named to break a shell script or an sbatch pattern: spaces, both quotes,
+/// `$(…)` and backticks that would create a file if run, and `%` patterns. `submit.sh`, run
+/// by bash as a person would, must run no command from it and have Slurm write the logs,
+/// the shards and the merged report into that very folder.
+#[test]
+fn slurm_takes_a_hostile_job_folder_exactly() {
+    let Some(conf) = tool("GLOFFUSE_TEST_SLURM_CONF", "a Slurm cluster") else {
+        return;
+    };
+    let Some((blender, lib)) = library() else {
+        return;
+    };
+    let expected = local_rules_report().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let job = dir
+        .path()
+        .join("out $(touch made-by-dollar) `touch made-by-backtick` \"q\" 'q' %a %j %% 100%");
+    gloffuse()
+        .args(["farm", "slurm"])
+        .arg(lib)
+        .args(["--shards", "2", "--out"])
+        .arg(&job)
+        .args(["--", "--no-render", "--no-provision", "--blender"])
+        .arg(blender)
+        .assert()
+        .success();
+    let submit = std::process::Command::new("bash")
+        .arg(job.join("submit.sh"))
+        .current_dir(dir.path())
+        .env("SLURM_CONF", &conf)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&submit.stdout).into_owned();
+    let err = String::from_utf8_lossy(&submit.stderr);
+    assert!(submit.status.success(), "{said}{err}");
+    // Its last line names the merged report's folder as it is.
+    let merged = job.join("merged");
+    assert!(
+        said.trim_end()
+            .ends_with(&format!("merged report: {}", merged.display())),
+        "{said}"
+    );
+    let merge_job = said
+        .split("merge: job ")
+        .nth(1)
+        .and_then(|r| r.split([';', ' ']).next())
+        .unwrap_or_else(|| panic!("{said}"));
+    let (state, exit) = wait_for_job(&conf, merge_job, Duration::from_secs(300));
+    assert_eq!((state.as_str(), exit.as_str()), ("FAILED", "1:0"), "{said}");
+    for made in ["made-by-dollar", "made-by-backtick"] {
+        assert!(!dir.path().join(made).exists(), "{made}: a command ran");
+    }
+    for k in 1..=2 {
+        assert!(job.join(format!("logs/shard-{k}.log")).is_file());
+        assert!(job.join(format!("shard-{k}/report.json")).is_file());
+    }
+    assert!(job.join("logs/merge.log").is_file());
+    assert_same(
+        expected,
+        &comparable(json(&job.join("merged.json"))),
+        0.0,
+        "slurm",
+    );
+    // Nothing was written beside the job's folder.
+    let beside: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(beside, [job.file_name().unwrap()]);
+}
+
 /// Polls `scontrol show job ID` until the job ends: its JobState and ExitCode.
 fn wait_for_job(conf: &str, id: &str, limit: Duration) -> (String, String) {
     let start = Instant::now();

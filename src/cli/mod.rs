@@ -25,7 +25,7 @@ mod text;
 
 use clap::Parser;
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicI32, Ordering};
@@ -371,7 +371,7 @@ fn write_audit_junit(path: Option<&Path>, report: &AuditReport, rerun: &str) -> 
 /// `report merge`: the shards read and checked, then the outputs of one unsharded audit.
 fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<Outcome> {
     use gloffuse::audit::merge::{merge, read_report, report_json};
-    use gloffuse::report::audit::{ReportDir, picture_of};
+    use gloffuse::report::audit::{ReportDir, ShardPicture, ShardPictures};
     if let Some(dir) = &m.report {
         gloffuse::report::check_dir(dir)?;
     }
@@ -392,22 +392,36 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         let mut folder = ReportDir::create(dir)?;
         let mut unpictured = std::collections::BTreeSet::new();
         // Each shard's folder: the one holding its report.json.
-        let folders: Vec<PathBuf> = (merged.shards.iter())
+        // Each shard's pictures, in the folder holding its report.json (none from a shard
+        // whose materials/ is refused).
+        let pictures: Vec<Option<ShardPictures>> = (merged.shards.iter())
             .map(|s| {
-                report_json(s)
-                    .parent()
-                    .unwrap_or(Path::new("."))
-                    .to_path_buf()
+                let json = report_json(s);
+                ShardPictures::open(json.parent().unwrap_or(Path::new(".")))
+                    .map_err(|link| refused_picture(&link))
+                    .ok()
             })
             .collect();
         for (&(k, i), material) in merged.sources.iter().zip(&report.materials) {
-            let picture = picture_of(&folders[k], i);
-            let found = picture.is_file();
-            if !found && material.mean.is_some() {
-                unpictured.insert(k + 1);
-            }
             cancel().check()?;
-            folder.add_copy(found.then_some(picture.as_path()))?;
+            let Some(shard) = &pictures[k] else {
+                folder.add_copy(None)?;
+                continue;
+            };
+            let copy = match shard.picture(i) {
+                ShardPicture::File(path, file) => Some((path, file)),
+                ShardPicture::Missing => {
+                    if material.mean.is_some() {
+                        unpictured.insert(k + 1);
+                    }
+                    None
+                }
+                ShardPicture::Refused(path) => {
+                    refused_picture(&path);
+                    None
+                }
+            };
+            folder.add_copy(copy)?;
         }
         for k in unpictured {
             eprintln_quietly(&format!(
@@ -433,6 +447,15 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         out.write_all(gloffuse::report::audit::table::render(report).as_bytes())?;
     }
     Ok(verdict(report.passed || m.exit_zero))
+}
+
+/// The note for a shard's picture (or `materials/`) left out of a merged report.
+fn refused_picture(path: &Path) {
+    eprintln_quietly(&format!(
+        "note: skipped {}: a symbolic link or not a regular file (a merge copies only a shard's \
+         own pictures, never what a link points to)",
+        path.display()
+    ));
 }
 
 /// The command line this process was started with, quoted for a shell: how to rerun it.

@@ -7,6 +7,7 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use gloffuse::progress::Progress;
+use gloffuse::report::escape::{terminal, terminal_lines};
 
 #[derive(Default)]
 pub struct Terminal {
@@ -24,7 +25,7 @@ impl Terminal {
                 .expect("a valid template")
                 .progress_chars("=> "),
         );
-        bar.set_message(message.to_string());
+        bar.set_message(terminal(message).into_owned());
         bar.enable_steady_tick(Duration::from_millis(200));
         if let Ok(mut guard) = self.bar.lock()
             && let Some(old) = guard.replace(bar)
@@ -89,7 +90,7 @@ impl Progress for Terminal {
     }
 
     fn doing(&self, what: &str) {
-        self.with_bar(|bar| bar.set_message(what.to_string()));
+        self.with_bar(|bar| bar.set_message(terminal(what).into_owned()));
     }
 
     fn end(&self) {
@@ -119,9 +120,11 @@ fn seconds_left_words(seconds_left: Option<f64>) -> String {
     }
 }
 
-/// A line on stderr; a closed stderr is not worth failing over.
+/// A line on stderr (or several: its newlines are kept), with every other control
+/// character shown as text, since it may quote names from users' files; a closed stderr is
+/// not worth failing over.
 pub fn eprintln_quietly(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
+    let _ = writeln!(std::io::stderr(), "{}", terminal_lines(line));
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ use gloffuse::fit::{ColorSpace, Curve, Shown, Target, Variable, Weighting};
 use gloffuse::generate::Generated;
 use gloffuse::lut::LutSummary;
 use gloffuse::refresh::Refreshed;
+use gloffuse::report::escape::terminal;
 use gloffuse::verify::VerifyReport;
 
 /// The summary `generate` prints.
@@ -41,7 +42,8 @@ pub fn generated(out: &Generated) -> String {
             s,
             "renamed: your group '{}' (not made by gloffuse) is now '{}'; materials using it \
              still do",
-            r.group, r.renamed_to
+            terminal(&r.group),
+            terminal(&r.renamed_to)
         );
     }
     s

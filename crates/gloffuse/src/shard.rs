@@ -3,7 +3,8 @@
 //! estimated costs, so every node, given the same inputs, computes the same split and takes
 //! its own part: no queue, no coordinator.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
@@ -83,8 +84,22 @@ pub fn in_order<T>(shards: Vec<(PathBuf, Option<Shard>, T)>) -> Result<Vec<(Path
             ),
         ));
     };
-    let mut slots: Vec<Option<(PathBuf, T)>> = (0..count).map(|_| None).collect();
+    // A report is data anyone who can write its folder may have edited: its numbers size
+    // and index nothing. The shards are placed by index in a map as large as the reports
+    // given, whatever count they claim.
+    let first = shards[0].0.clone();
+    let mut placed: BTreeMap<usize, (PathBuf, T)> = BTreeMap::new();
     for (path, shard, report) in shards {
+        if let Some(s) = shard.filter(|s| s.index == 0 || s.index > s.count) {
+            return Err(Error::input(
+                Field::ShardReport,
+                path.display(),
+                format!(
+                    "a shard K/N with 1 ≤ K ≤ N, not {}/{} (was it edited?)",
+                    s.index, s.count
+                ),
+            ));
+        }
         let Some(shard) = shard.filter(|s| s.count == count) else {
             let what = match shard {
                 Some(s) => Hint::text(format!("shard {s}")),
@@ -93,40 +108,58 @@ pub fn in_order<T>(shards: Vec<(PathBuf, Option<Shard>, T)>) -> Result<Vec<(Path
             return Err(Error::input(
                 Field::ShardReport,
                 path.display(),
-                Hint::text(format!("a shard of {count} like the first report, not ")).then(what),
+                Hint::text(format!(
+                    "a shard of {count} like the first report ({}), not ",
+                    first.display()
+                ))
+                .then(what),
             ));
         };
-        let slot = &mut slots[shard.index - 1];
-        if let Some((first, _)) = slot {
+        if let Some((other, _)) = placed.get(&shard.index) {
             return Err(Error::input(
                 Field::ShardReport,
                 path.display(),
                 Hint::text(format!(
                     "each shard once: shard {shard} is also {}",
-                    first.display()
+                    other.display()
                 )),
             ));
         }
-        *slot = Some((path, report));
+        placed.insert(shard.index, (path, report));
     }
-    let missing: Vec<String> = (1..=count)
-        .filter(|&k| slots[k - 1].is_none())
+    if placed.len() < count {
+        return Err(missing(count, &placed, &first));
+    }
+    Ok(placed.into_values().collect())
+}
+
+/// The error of shards of `count` of which only those `placed` were given, `first` the
+/// report that gives the count: the first few missing, found in as many steps as there are
+/// reports (a count may be 10¹⁵).
+fn missing<T>(count: usize, placed: &BTreeMap<usize, T>, first: &Path) -> Error {
+    const SHOWN: usize = 10;
+    let mut missing: Vec<String> = (1..=count)
+        .filter(|k| !placed.contains_key(k))
+        .take(SHOWN)
         .map(|k| format!("{k}/{count}"))
         .collect();
-    if !missing.is_empty() {
-        return Err(Error::input(
-            Field::ShardReport,
-            format!("{} reports", count - missing.len()),
-            Hint::new(
-                format!(
-                    "every shard of {count}: missing {} (its report.json or {{}} folder)",
-                    missing.join(", ")
-                ),
-                [Field::Report],
-            ),
-        ));
+    let more = count - placed.len() - missing.len();
+    if more > 0 {
+        missing.push(format!("and {more} more"));
     }
-    Ok(slots.into_iter().map(|s| s.expect("checked")).collect())
+    Error::input(
+        Field::ShardReport,
+        format!("{} reports", placed.len()),
+        Hint::new(
+            format!(
+                "every shard of {count}, as {} says: missing {} (its report.json or {{}} \
+                 folder)",
+                first.display(),
+                missing.join(", ")
+            ),
+            [Field::Report],
+        ),
+    )
 }
 
 #[cfg(test)]
@@ -199,6 +232,25 @@ mod tests {
         );
         let other = in_order(vec![(p("a"), shard(1, 2), 0), (p("c"), shard(1, 3), 0)]);
         assert!(other.unwrap_err().to_string().contains("not shard 1/3"));
+        let huge = in_order(vec![
+            (p("a"), shard(1, usize::MAX), 0),
+            (p("b"), shard(2, 2), 0),
+        ]);
+        assert!(huge.unwrap_err().to_string().contains("first report (a)"));
+        let alone = in_order(vec![(p("a"), shard(3, 1 << 50), 0)]).unwrap_err();
+        assert!(
+            alone.to_string().contains(&format!(
+                "as a says: missing 1/{n}, 2/{n}, 4/{n}, 5/{n}, 6/{n}, 7/{n}, 8/{n}, 9/{n}, \
+                 10/{n}, 11/{n}, and {} more",
+                (1usize << 50) - 11,
+                n = 1usize << 50
+            )),
+            "{alone}"
+        );
+        let zero = in_order(vec![(p("a"), shard(1, 2), 0), (p("z"), shard(0, 2), 0)]);
+        assert!(zero.unwrap_err().to_string().contains("'z'"));
+        let above = in_order(vec![(p("y"), shard(3, 2), 0), (p("a"), shard(1, 2), 0)]);
+        assert!(above.unwrap_err().to_string().contains("'y'"));
         let plain = in_order(vec![(p("a"), None, 0)]);
         assert!(
             plain

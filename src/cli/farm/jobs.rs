@@ -134,7 +134,7 @@ pub fn slurm(job: &FarmJob, sbatch_args: &[String]) -> SlurmJob {
             "--parsable".to_string(),
             format!("--job-name={name}"),
             format!("--chdir={}", job.workdir.display()),
-            format!("--output={dir}/logs/{log}"),
+            format!("--output={}/logs/{log}", sbatch_pattern(&dir)),
         ];
         args.extend(sbatch_args.iter().cloned());
         args
@@ -154,7 +154,7 @@ pub fn slurm(job: &FarmJob, sbatch_args: &[String]) -> SlurmJob {
         "#!/bin/bash\n# Submits the sharded audit and its merge (`gloffuse farm slurm`).\nset -euo pipefail\n\
          audit=$(sbatch {})\n\
          merge=$(sbatch --dependency=afterany:\"${{audit%%;*}}\" {})\n\
-         echo \"audit: array job $audit ({n} shards); merge: job $merge; merged report: {merged}\"\n",
+         echo \"audit: array job $audit ({n} shards); merge: job $merge; merged report: \"{merged}\n",
         quoted(&audit_sbatch),
         quoted(&merge_sbatch),
         n = job.shards,
@@ -167,6 +167,13 @@ pub fn slurm(job: &FarmJob, sbatch_args: &[String]) -> SlurmJob {
         merge_sbatch,
         submit_script,
     }
+}
+
+/// `text` as it must be written in an `sbatch` filename pattern (`--output`) to mean
+/// itself: Slurm reads `%` as the start of a replacement (`%a`, the task) and `%%` as `%`.
+/// (A pattern holding a backslash is read another way; `farm slurm` refuses such a folder.)
+fn sbatch_pattern(text: &str) -> String {
+    text.replace('%', "%%")
 }
 
 /// An Open Job Description job: its template and the values of its parameters.

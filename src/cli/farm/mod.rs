@@ -58,6 +58,9 @@ fn job(a: &FarmArgs) -> Result<FarmJob> {
     }
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     let program = match &a.gloffuse {
+        // A path (with a `/`) is made absolute as the others are: a node runs it from
+        // another folder. A bare name stays a command the nodes find on their PATH.
+        Some(p) if p.contains('/') => absolute(Path::new(p)).display().to_string(),
         Some(p) => p.clone(),
         None => std::env::current_exe()
             .map(|p| p.display().to_string())
@@ -99,6 +102,16 @@ pub fn openjd_template(a: &FarmArgs, out: &mut dyn Write) -> Result<Outcome> {
 /// `farm slurm`: the scripts, and with `--submit` the array job and its merge job.
 pub fn slurm_job(a: &SlurmArgs, out: &mut dyn Write) -> Result<Outcome> {
     let job = job(&a.farm)?;
+    if job.dir.as_os_str().as_encoded_bytes().contains(&b'\\') {
+        // Slurm reads a log path holding a backslash without its `%a` and drops the
+        // backslashes: the logs would land elsewhere, all in one file.
+        return Err(Error::input(
+            Field::Out,
+            job.dir.display(),
+            "a folder with no backslash in its path (Slurm's --output gives them a meaning)",
+        )
+        .into());
+    }
     let s = slurm(&job, &a.sbatch_arg);
     make_report_dir(&job.dir)?;
     make_report_dir(&job.dir.join("logs"))?;

@@ -33,10 +33,7 @@ pub fn report_json(path: &Path) -> PathBuf {
 /// Reads the audit report at `path` (a report.json, or the folder holding one).
 pub fn read_report(path: &Path) -> Result<AuditReport, Error> {
     let json = report_json(path);
-    let text = std::fs::read_to_string(&json).map_err(|source| Error::Read {
-        path: json.clone(),
-        source,
-    })?;
+    let text = read_regular(&json)?;
     serde_json::from_str(&text).map_err(|e| {
         Error::input(
             Field::ShardReport,
@@ -47,6 +44,39 @@ pub fn read_report(path: &Path) -> Result<AuditReport, Error> {
             ),
         )
     })
+}
+
+/// The text of `path`, a regular file (or a link to one). A shard's folder is on storage
+/// others write: a FIFO or a device there is refused, and opened without blocking, so one
+/// put in place between the check and the open is refused too rather than hanging the merge.
+fn read_regular(path: &Path) -> Result<String, Error> {
+    use std::io::Read;
+    use std::os::unix::fs::OpenOptionsExt;
+    let read_error = |source| Error::Read {
+        path: path.to_path_buf(),
+        source,
+    };
+    let not_regular = || {
+        Error::input(
+            Field::ShardReport,
+            path.display(),
+            "a regular file (a shard's report.json), not a FIFO, device, socket or folder",
+        )
+    };
+    if !std::fs::metadata(path).map_err(read_error)?.is_file() {
+        return Err(not_regular());
+    }
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(read_error)?;
+    if !file.metadata().map_err(read_error)?.is_file() {
+        return Err(not_regular());
+    }
+    let mut text = String::new();
+    file.read_to_string(&mut text).map_err(read_error)?;
+    Ok(text)
 }
 
 /// Merges every shard of one run, given in any order.

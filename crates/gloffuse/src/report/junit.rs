@@ -1,9 +1,12 @@
 //! The verify report as JUnit XML, for CI servers: one test case per corrected sphere (its
 //! mean), and in the view modes one per sphere's view-cosine rings, with what was measured,
 //! predicted and allowed as properties and, on failure, the message and the commands to
-//! rerun the check and the render.
+//! rerun the check and the render. Paths and versions go through [`xml_attribute`] and
+//! [`xml_text`] as the audit's names do, so the XML stays valid whatever they hold.
 
 use quick_junit::{NonSuccessKind, Property, Report, TestCase, TestCaseStatus, TestSuite};
+
+use crate::report::escape::{xml_attribute, xml_text};
 
 use crate::generate::Mode;
 use crate::verify::{Row, VerifyReport};
@@ -39,7 +42,7 @@ fn add_suite_properties(suite: &mut TestSuite, report: &VerifyReport) {
             report.ring_tolerance_percent.to_string(),
         ),
     ] {
-        suite.add_property(Property::new(name, value));
+        suite.add_property(Property::new(name, xml_attribute(&value)));
     }
 }
 
@@ -113,11 +116,11 @@ fn failure(report: &VerifyReport, rerun: &str, message: String) -> TestCaseStatu
     let info = &report.render;
     let mut status = TestCaseStatus::non_success(NonSuccessKind::Failure);
     status
-        .set_message(message.as_str())
-        .set_description(format!(
+        .set_message(xml_attribute(&message))
+        .set_description(xml_text(&format!(
             "{message}\nrerun: {rerun}\nrender: {}\nlog: {}",
             info.command, info.log
-        ));
+        )));
     status
 }
 

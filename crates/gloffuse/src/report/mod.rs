@@ -1,10 +1,12 @@
 //! ⑤ Report: renderers of the verify verdict, one file each — `table` (terminal), `json`
 //! (machines), `junit` (CI servers), `html` (a page for people), `png` (the contact sheet
 //! and the brightness plot), `deviation` (the false-colour view), `notes` (the verdict's
-//! notes in words), `words` (the verdict and the mode in words) — and the report folder that holds them with the rendered EXR.
+//! notes in words), `words` (the verdict and the mode in words), `escape` (users' names made
+//! safe for a terminal and for XML) — and the report folder that holds them with the rendered EXR.
 
 pub mod audit;
 pub mod deviation;
+pub mod escape;
 pub mod html;
 pub mod json;
 pub mod junit;

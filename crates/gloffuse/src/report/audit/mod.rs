@@ -80,16 +80,19 @@ impl ReportDir {
         Ok(())
     }
 
-    /// Adds the next material's picture as a copy of `from` (a shard's picture), if any.
-    pub fn add_copy(&mut self, from: Option<&Path>) -> Result<(), Error> {
+    /// Adds the next material's picture as a copy of `from` (a shard's picture, opened by
+    /// [`ShardPictures::picture`]), if any.
+    pub fn add_copy(&mut self, from: Option<(PathBuf, std::fs::File)>) -> Result<(), Error> {
         let picture = match from {
-            Some(from) => {
+            Some((from, mut source)) => {
                 let file = picture_name(self.pictures.len());
                 let path = self.staging().join(&file);
-                std::fs::copy(from, &path).map_err(|e| Error::Write {
+                let failed = |e: std::io::Error| Error::Write {
                     path: path.clone(),
                     message: format!("copying {}: {e}", from.display()),
-                })?;
+                };
+                let mut copy = std::fs::File::create(&path).map_err(failed)?;
+                std::io::copy(&mut source, &mut copy).map_err(failed)?;
                 Some(format!("{PICTURES}/{file}"))
             }
             None => None,
@@ -141,10 +144,82 @@ impl Drop for ReportDir {
     }
 }
 
-/// The picture of the material at `index` of a report's materials, in the folder `dir`
-/// holding that report (it exists if the material was rendered).
-pub fn picture_of(dir: &Path, index: usize) -> PathBuf {
-    dir.join(PICTURES).join(picture_name(index))
+/// A shard's pictures, as `report merge` copies them: only regular files in a `materials/`
+/// that is a folder, neither being a symbolic link. A shard's folder is on storage others
+/// can write, and a link there would have the merge publish whatever file it points to.
+/// The folder is opened once and each picture opened inside it without following links,
+/// so a link put in place after the checks is refused as well.
+pub struct ShardPictures {
+    folder: PathBuf,
+    dir: Option<std::fs::File>,
+}
+
+/// A shard's picture of one material.
+pub enum ShardPicture {
+    /// A regular file, open to copy; its path.
+    File(PathBuf, std::fs::File),
+    /// None: the material was not rendered, or its shard ran without `--report`.
+    Missing,
+    /// A symbolic link or another file that is not a regular one (a FIFO, a device): not
+    /// copied.
+    Refused(PathBuf),
+}
+
+impl ShardPictures {
+    /// The pictures of the shard whose report is in `dir`; `Err` names its `materials/` if
+    /// that is a symbolic link or no folder.
+    pub fn open(dir: &Path) -> Result<Self, PathBuf> {
+        use std::os::unix::fs::OpenOptionsExt;
+        let folder = dir.join(PICTURES);
+        let meta = match std::fs::symlink_metadata(&folder) {
+            Ok(meta) => meta,
+            Err(_) => return Ok(ShardPictures { folder, dir: None }),
+        };
+        if !meta.is_dir() {
+            return Err(folder);
+        }
+        let dir = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_DIRECTORY | libc::O_NOFOLLOW)
+            .open(&folder)
+            .map_err(|_| folder.clone())?;
+        Ok(ShardPictures {
+            folder,
+            dir: Some(dir),
+        })
+    }
+
+    /// The picture of the material at `index` of the shard's report.
+    pub fn picture(&self, index: usize) -> ShardPicture {
+        use std::os::fd::{AsRawFd, FromRawFd};
+        let Some(dir) = &self.dir else {
+            return ShardPicture::Missing;
+        };
+        let name = picture_name(index);
+        let path = self.folder.join(&name);
+        let c_name = std::ffi::CString::new(name).expect("a picture's name has no NUL");
+        // SAFETY: `dir` is an open folder and `c_name` a NUL-terminated name; a descriptor
+        // returned is owned by the File made of it alone.
+        let fd = unsafe {
+            libc::openat(
+                dir.as_raw_fd(),
+                c_name.as_ptr(),
+                libc::O_RDONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_CLOEXEC,
+            )
+        };
+        if fd < 0 {
+            return match std::io::Error::last_os_error().raw_os_error() {
+                Some(libc::ENOENT) => ShardPicture::Missing,
+                _ => ShardPicture::Refused(path),
+            };
+        }
+        // SAFETY: `fd` was just opened and is owned by nothing else.
+        let file = unsafe { std::fs::File::from_raw_fd(fd) };
+        match file.metadata() {
+            Ok(meta) if meta.is_file() => ShardPicture::File(path, file),
+            _ => ShardPicture::Refused(path),
+        }
+    }
 }
 
 fn picture_name(index: usize) -> String {

@@ -1,7 +1,10 @@
 //! The audit verdict for a terminal: one line per material (failures first), then its
-//! findings, the file findings, and the counts.
+//! findings, the file findings, and the counts. Every name and message in it comes from
+//! users' files (or a shard's report.json) and is shown through [`terminal`], so none can
+//! drive the terminal or start a line of its own.
 
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Verdict};
+use crate::report::escape::terminal;
 
 /// A brightness in percent, or a dash where there is none.
 pub(super) fn pct(x: Option<f64>) -> String {
@@ -21,7 +24,7 @@ pub fn render(report: &AuditReport) -> String {
         "Audit of {} materials in {} files, Blender {} ({} px, {} spp)\n\n",
         report.counts.materials,
         report.counts.files,
-        report.blender_version,
+        terminal(&report.blender_version),
         report.settings.cell,
         report.settings.samples
     );
@@ -37,16 +40,16 @@ pub fn render(report: &AuditReport) -> String {
             pct(m.mean),
             pct(m.rim),
             pct(m.twin_mean),
-            m.material,
-            short(&m.file),
+            terminal(&m.material),
+            terminal(short(&m.file)),
             if rules.is_empty() {
                 String::new()
             } else {
-                format!(" — {}", rules.join(", "))
+                format!(" — {}", terminal(&rules.join(", ")))
             }
         ));
         if m.verdict != Verdict::Ok {
-            s.push_str(&format!("{:<36}{}\n", "", m.reason));
+            s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
         }
         if let Some(after) = m.after.as_ref().filter(|_| m.replaced > 0) {
             s.push_str(&format!(
@@ -82,23 +85,27 @@ pub fn render(report: &AuditReport) -> String {
 /// A file's error, its own findings and its fix, each on a line of its own.
 fn file_lines(f: &AuditedFile) -> String {
     let mut s = String::new();
+    let file = terminal(&f.file);
     if let Some(e) = &f.error {
-        s.push_str(&format!("\nerror   {}: {e}\n", f.file));
+        s.push_str(&format!("\nerror   {file}: {}\n", terminal(e)));
     }
     for finding in &f.findings {
         s.push_str(&format!(
-            "\n{}: {} — {}\n",
-            f.file, finding.rule, finding.why
+            "\n{file}: {} — {}\n",
+            terminal(&finding.rule),
+            terminal(&finding.why)
         ));
     }
     if let Some(fixed) = &f.fixed {
         s.push_str(&format!(
-            "\nfixed   {} → {} ({} lobes replaced)\n",
-            f.file, fixed.path, fixed.replaced
+            "\nfixed   {file} → {} ({} lobes replaced)\n",
+            terminal(&fixed.path),
+            fixed.replaced
         ));
         if let Some(e) = &fixed.after_error {
             s.push_str(&format!(
-                "        the fixed file could not be audited again: {e}\n"
+                "        the fixed file could not be audited again: {}\n",
+                terminal(e)
             ));
         }
     }
