@@ -67,13 +67,13 @@ fn a_compressed_file_is_counted_through_every_frame() {
         let (file, listed) = many_materials(&blender, dir.path(), MANY);
         assert_eq!(listed, MANY, "Blender {label}");
         let bytes = std::fs::read(&file).unwrap();
-        assert_eq!(bytes[..4], [0x28, 0xb5, 0x2f, 0xfd], "Blender {label}: zstd");
-        assert!(bytes.len() > 256 * 1024, "Blender {label}: several frames");
         assert_eq!(
-            count_blocks(&file, MATERIAL),
-            Ok(listed),
-            "Blender {label}"
+            bytes[..4],
+            [0x28, 0xb5, 0x2f, 0xfd],
+            "Blender {label}: zstd"
         );
+        assert!(bytes.len() > 256 * 1024, "Blender {label}: several frames");
+        assert_eq!(count_blocks(&file, MATERIAL), Ok(listed), "Blender {label}");
     }
 }
 
@@ -111,7 +111,7 @@ fn thousands_of_materials_are_judged_and_a_grid_too_large_is_an_error() {
     for m in materials {
         let name = m["material"].as_str().unwrap();
         let k: usize = name.trim_start_matches("material-").parse().unwrap();
-        let expected = if k % 2 == 0 { "loses" } else { "ok" };
+        let expected = if k.is_multiple_of(2) { "loses" } else { "ok" };
         assert_eq!(m["verdict"], expected, "{name}: {}", m["reason"]);
     }
     let pictures = std::fs::read_dir(report_dir.join("materials"))
@@ -194,7 +194,8 @@ fn a_full_disk_is_named_when_a_fix_cannot_be_saved() {
         );
         let error = report["files"][0]["error"].as_str().unwrap_or_default();
         assert!(
-            error.contains("no space left on the device") && error.contains(&*full.to_string_lossy()),
+            error.contains("no space left on the device")
+                && error.contains(&*full.to_string_lossy()),
             "Blender {label}: {error}\n{stderr}"
         );
         assert!(!out.exists(), "Blender {label}");

@@ -244,12 +244,20 @@ mod tests {
         use ruzstd::encoding::{CompressionLevel, compress_to_vec};
         let mut bytes = b"BLENDER-v405".to_vec();
         for i in 0..300 {
-            bytes.extend(block(if i % 3 == 0 { b"MA\0\0" } else { b"DATA" }, &[7; 100]));
+            bytes.extend(block(
+                if i % 3 == 0 { b"MA\0\0" } else { b"DATA" },
+                &[7; 100],
+            ));
         }
         bytes.extend(block(b"ENDB", &[]));
         let mut stream = Vec::new();
         // Frames cut mid-block, and an empty one.
-        for part in [&bytes[..5000], &bytes[5000..5000], &bytes[5000..20001], &bytes[20001..]] {
+        for part in [
+            &bytes[..5000],
+            &bytes[5000..5000],
+            &bytes[5000..20001],
+            &bytes[20001..],
+        ] {
             stream.extend(compress_to_vec(part, CompressionLevel::Fastest));
         }
         stream.extend(0x184D_2A5E_u32.to_le_bytes());

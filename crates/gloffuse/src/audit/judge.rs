@@ -310,6 +310,9 @@ mod tests {
         let message = check_grid(&job(2, &[(0, 5)]), Some(&image), 32)
             .unwrap_err()
             .to_string();
-        assert!(message.contains("64 x 32 px") && message.contains("cell 5"), "{message}");
+        assert!(
+            message.contains("64 x 32 px") && message.contains("cell 5"),
+            "{message}"
+        );
     }
 }

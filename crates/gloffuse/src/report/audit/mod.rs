@@ -234,6 +234,9 @@ mod tests {
             assert_eq!(made, pictures, "grid {grid:?}");
         }
         assert!(cell_image(&image, 2, 16, 2).is_none());
-        assert_eq!(cell_image(&image, 2, 16, 1).map(|c| c.len()), Some(16 * 16 * 3));
+        assert_eq!(
+            cell_image(&image, 2, 16, 1).map(|c| c.len()),
+            Some(16 * 16 * 3)
+        );
     }
 }
