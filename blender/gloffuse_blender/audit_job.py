@@ -31,7 +31,7 @@ from .audit_twin import (
     set_aside_groups,
 )
 from .compat import blender_version_string, filter_glossy_property, material_node_tree
-from .furnace import furnace_place_materials, furnace_stage, render_sweep
+from .furnace import furnace_layout, furnace_place_materials, furnace_stage, render_sweep
 from .groups import build_all, group_names
 from .params import resolve_params
 from .runtime import (
@@ -67,7 +67,7 @@ def audit_params(document):
     render = bool(section.get("render", True))
     audit_require(not render or isinstance(section.get("output"), str), "\"output\" must be a path")
     audit_require(isinstance(section.get("rules"), list), "\"rules\" must be a list")
-    for key in ("cell", "samples", "columns"):
+    for key in ("cell", "samples"):
         audit_require(isinstance(section.get(key), int) and section[key] >= 1,
                       "%r must be a positive integer" % key)
     return dict(section, render=render, engine="cycles", seed=int(section.get("seed", 0)),
@@ -204,19 +204,19 @@ def audit_render_settings(scene):
 
 
 def furnace_render(entries, audit):
-    """Twins, the furnace in the context scene, one render. Returns (scene, seconds)
-    or (None, 0.0) when no material can be rendered."""
+    """Twins, the furnace in the context scene, one render. Returns (scene,
+    columns, seconds) or (None, None, 0.0) when no material can be rendered."""
     cells = twins_and_cells(entries)
     if not cells:
-        return None, 0.0
+        return None, None, 0.0
     scene = bpy.context.scene
-    columns = audit["columns"]
-    rows = (len(cells) + columns - 1) // columns
+    # Laid out from the cells made, not from what gloffuse counted before.
+    columns, rows = furnace_layout(len(cells), audit["cell"])
     clear_scene(scene)
     furnace_stage(scene, audit, columns, rows)
     audit_render_settings(scene)
     furnace_place_materials(scene, audit, cells, columns, rows)
-    return scene, render_sweep(os.path.abspath(audit["output"]))
+    return scene, columns, render_sweep(os.path.abspath(audit["output"]))
 
 
 # --- main ----------------------------------------------------------------------------
@@ -278,11 +278,11 @@ def audit_main(document_text):
             entries = [dict(fresh, findings=entry["findings"], error=entry["error"])
                        for fresh, entry in zip(scan_file(rules, groups), entries)]
 
-    scene, seconds = None, 0.0
+    scene, columns, seconds = None, None, 0.0
     if audit["render"]:
         if needs:
             build_twin_groups(document)
-        scene, seconds = furnace_render(entries, audit)
+        scene, columns, seconds = furnace_render(entries, audit)
     else:
         for entry in entries:
             entry["replaced"] = sum(1 for item in entry["findings"] if has_replacement(item))
@@ -293,7 +293,7 @@ def audit_main(document_text):
         "output": os.path.abspath(audit["output"]) if scene is not None else None,
         "width": scene.render.resolution_x if scene is not None else 0,
         "height": scene.render.resolution_y if scene is not None else 0,
-        "columns": audit["columns"],
+        "columns": columns,
         "scan_seconds": round(scan_seconds, 3),
         "render_seconds": round(seconds, 3),
         "file_findings": file_findings,

@@ -22,7 +22,7 @@ import os
 import bpy
 
 from .compat import filter_glossy_property, is_missing, material_node_tree, principled_input, version_in_range
-from .nodes import is_tagged
+from .nodes import is_gloffuse_group
 
 # Distributions whose single-scattering lobe loses energy, and what the twin
 # puts in place: Multiscatter GGX on the node itself, else a gloffuse group.
@@ -42,7 +42,6 @@ REFLECTING_EXTRA = ("ShaderNodeSubsurfaceScattering", "ShaderNodeEeveeSpecular")
 LIGHT_NODES = NOT_REFLECTING
 KNOWN_OTHER_TYPES = ("NodeGroup", "NodeReroute", "NodeFrame", "NodeGroupInput",
                      "NodeGroupOutput", "ShaderNodeGroup")
-OWN_GROUP_PREFIXES = ("Gloffuse ", "Brightness Correction")
 COLOR_EPSILON = 1e-6
 
 
@@ -62,8 +61,10 @@ def twin_groups(audit):
 
 
 def is_own_group(tree):
-    """A gloffuse group: already corrected, never scanned or flagged."""
-    return is_tagged(tree) or tree.name.startswith(OWN_GROUP_PREFIXES)
+    """A gloffuse group as gloffuse built it: already corrected, never scanned
+    or flagged. Known by its tag and content (nodes.py's is_gloffuse_group),
+    never by its name: a user's group of any name is scanned."""
+    return is_gloffuse_group(tree)
 
 
 # --- sockets and the walk ----------------------------------------------------------

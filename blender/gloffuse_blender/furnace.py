@@ -55,6 +55,10 @@ FURNACE_SPHERE_RINGS = 128
 # One world unit per grid cell; the camera sits well above the spheres.
 FURNACE_CAMERA_HEIGHT = 10.0
 
+# Blender clamps a render's resolution to this many pixels a side, silently:
+# a larger grid would lose its last rows and columns.
+FURNACE_MAX_RESOLUTION = 65536
+
 # A solid furnace's sphere k sits this far below sphere k - 1: seen from one
 # sphere (radius <= 0.5) the others cover at most sum 2 r^2 / (4 (16 k)^2) =
 # 0.08 % of its sky, and they return most of that light anyway.
@@ -182,6 +186,21 @@ def furnace_grid(furnace):
     """(columns, rows) of the grid; row-major, row 0 at the top."""
     columns = furnace["columns"]
     rows = (len(furnace["spheres"]) + columns - 1) // columns
+    return columns, rows
+
+
+def furnace_layout(cells, cell):
+    """(columns, rows) of the about square grid of `cells` cells of `cell`
+    pixels: the shape whose longer side is shortest, so the most cells fit in
+    FURNACE_MAX_RESOLUTION. A ValueError when even that is too large."""
+    columns = math.isqrt(max(cells, 1) - 1) + 1
+    rows = (max(cells, 1) + columns - 1) // columns
+    side = FURNACE_MAX_RESOLUTION // cell
+    if columns > side:
+        raise ValueError("%d spheres of %d px need a %d x %d px render, and Blender renders at "
+                         "most %d px a side: at most %d spheres fit at this cell size (a smaller "
+                         "cell fits more)" % (cells, cell, columns * cell, rows * cell,
+                                              FURNACE_MAX_RESOLUTION, side * side))
     return columns, rows
 
 
@@ -339,6 +358,10 @@ def furnace_camera(columns, depth):
 
 
 def furnace_render_settings(scene, furnace, columns, rows):
+    for side, count in (("wide", columns), ("high", rows)):
+        if count * furnace["cell"] > FURNACE_MAX_RESOLUTION:
+            raise ValueError("a furnace grid %d cells %s at %d px exceeds Blender's %d px limit"
+                             % (count, side, furnace["cell"], FURNACE_MAX_RESOLUTION))
     render = scene.render
     render.resolution_x = columns * furnace["cell"]
     render.resolution_y = rows * furnace["cell"]

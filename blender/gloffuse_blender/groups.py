@@ -14,7 +14,7 @@ import bpy
 from .anisotropic_groups import build_anisotropic_group
 from .glass_groups import build_glass_group
 from .layered_groups import build_layered_group
-from .nodes import GLOFFUSE_TAG, is_tagged
+from .nodes import GLOFFUSE_CONTENT, GLOFFUSE_TAG, content_fingerprint, is_tagged
 from .normal_group import build_normal_group
 from .params import validate_params
 from .roughness_groups import build_correction_group, build_shader_group
@@ -86,6 +86,10 @@ def build_all(params, on_spec=None):
             if tree.name not in names:
                 raise ValueError("group_names misses the group %r it must set aside" % tree.name)
             tree[GLOFFUSE_TAG] = params.get("gloffuse_version", "")
+    # Fingerprinted once every tree is complete (a group's holds the groups it nests).
+    for _spec, trees in built:
+        for tree in trees:
+            tree[GLOFFUSE_CONTENT] = content_fingerprint(tree)
     return built
 
 

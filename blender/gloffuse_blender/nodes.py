@@ -7,6 +7,9 @@
 # A module of the gloffuse_blender package. Functions and constants only;
 # every version difference it meets goes through compat.py.
 # ---------------------------------------------------------------------------
+import hashlib
+import json
+
 import bpy
 
 from .compat import (
@@ -130,8 +133,73 @@ def gain_at(curve, roughness):
 GLOFFUSE_TAG = "gloffuse"
 
 
+# The custom property holding a fingerprint of what gloffuse built in a group
+# (content_fingerprint), written beside the tag: the audit trusts a group only
+# while its tree is still exactly that.
+GLOFFUSE_CONTENT = "gloffuse_content"
+
+
 def is_tagged(id_block):
     return GLOFFUSE_TAG in id_block.keys()
+
+
+def _rna_value(value):
+    """A node setting or socket value as JSON: floats to 6 significant digits
+    (what a save and a reload keep), vectors as lists, enum flags sorted."""
+    if isinstance(value, float):
+        return float("%.6g" % value)
+    if isinstance(value, (bool, int, str)) or value is None:
+        return value
+    if isinstance(value, (set, frozenset)):
+        return sorted(value)
+    try:
+        return [_rna_value(v) for v in value]
+    except TypeError:
+        return repr(value)
+
+
+def _node_content(node, stack):
+    """What a node renders with: its type, mute, its own settings (every
+    writable property a plain node lacks), its unlinked inputs' values, and a
+    nested group's content or an image's name."""
+    base = {prop.identifier for prop in bpy.types.Node.bl_rna.properties}
+    settings = {prop.identifier: _rna_value(getattr(node, prop.identifier))
+                for prop in node.bl_rna.properties
+                if prop.identifier not in base and not prop.is_readonly
+                and prop.type in ("BOOLEAN", "INT", "FLOAT", "STRING", "ENUM")}
+    inputs = [[sock.identifier, _rna_value(getattr(sock, "default_value", None))]
+              for sock in node.inputs if not sock.is_linked]
+    tree = getattr(node, "node_tree", None)
+    image = getattr(node, "image", None)
+    return [node.name, node.bl_idname, bool(node.mute), settings, inputs,
+            None if tree is None else _tree_content(tree, stack),
+            None if image is None else image.name]
+
+
+def _tree_content(tree, stack=()):
+    if tree.name in stack:  # a group inside itself: Blender refuses it, never loop
+        return ["cycle", tree.name]
+    stack = stack + (tree.name,)
+    nodes = [_node_content(node, stack)
+             for node in sorted(tree.nodes, key=lambda n: n.name) if node.bl_idname != "NodeFrame"]
+    links = sorted([link.from_node.name, link.from_socket.identifier, link.to_node.name,
+                    link.to_socket.identifier, bool(link.is_muted)] for link in tree.links)
+    return [nodes, links]
+
+
+def content_fingerprint(tree):
+    """A hash of everything in `tree` that changes what it renders (nodes,
+    their settings and unconnected values, links, nested groups): any edit
+    after gloffuse built it changes it. Frames and layout are left out."""
+    text = json.dumps(_tree_content(tree), sort_keys=True)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def is_gloffuse_group(tree):
+    """A group exactly as gloffuse built it: tagged, and its content what the
+    fingerprint written at build time says (a copy edited afterwards, or a
+    user's group given the tag, is not)."""
+    return is_tagged(tree) and tree.get(GLOFFUSE_CONTENT) == content_fingerprint(tree)
 
 
 def set_aside_untagged(names):

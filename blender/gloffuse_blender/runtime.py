@@ -20,6 +20,7 @@ import json
 import os
 import shutil
 import sys
+import tempfile
 import traceback
 
 import bpy
@@ -86,13 +87,16 @@ def save_blend(path, compress=False):
     filepaths = bpy.context.preferences.filepaths
     old_versions = filepaths.save_version
     filepaths.save_version = 0
+    said = None
     try:
         result = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False,
                                              copy=False, compress=compress)
+    except RuntimeError as error:
+        result, said = (), " ".join(str(error).split())
     finally:
         filepaths.save_version = old_versions
-    if "FINISHED" not in result or not os.path.isfile(path):
-        raise RuntimeError("Blender could not save %s" % path)
+    if said is not None or "FINISHED" not in result or not os.path.isfile(path):
+        raise RuntimeError(save_failure(path, compress, said or "the save did not finish"))
     return path
 
 
@@ -100,6 +104,42 @@ def shown_path(path):
     """`path` as text for the result line: a name that is not UTF-8 (surrogate-escaped in
     Python) shows U+FFFD where its bad bytes are, as JSON can hold no lone surrogate."""
     return os.fsencode(path).decode("utf-8", "replace")
+
+
+def _size(n):
+    return "%.1f MB" % (n / 1e6) if n >= 100e3 else "%d bytes" % n
+
+
+def saved_size(compress):
+    """The bytes the open file takes saved (a copy written to a temporary
+    folder and removed), or None when even that fails."""
+    with tempfile.TemporaryDirectory(prefix="gloffuse-size-") as directory:
+        copy = os.path.join(directory, "size.blend")
+        try:
+            bpy.ops.wm.save_as_mainfile(filepath=copy, check_existing=False, copy=True,
+                                        compress=compress)
+            return os.path.getsize(copy)
+        except (RuntimeError, OSError):
+            return None
+
+
+def save_failure(path, compress, said):
+    """Why saving `path` failed, in words. On a full disk Blender says nothing
+    to the point ("Error: Success", or "No such file or directory" for the
+    file it could not finish), so the device's free space is compared with
+    what the file takes when saved elsewhere."""
+    directory = os.path.dirname(path) or "."
+    try:
+        free = shutil.disk_usage(directory).free
+    except OSError:
+        return "Blender could not save %s (Blender said: %s)" % (path, said)
+    needed = saved_size(compress)
+    if needed is not None and needed >= free:
+        return ("no space left on the device: saving %s takes about %s, and the device holding "
+                "%s has %s free; free some space there or save elsewhere (Blender said: %s)"
+                % (path, _size(needed), directory, _size(free), said))
+    return ("Blender could not save %s (Blender said: %s); the device holding %s has %s free"
+            % (path, said, directory, _size(free)))
 
 
 def result_line(payload):

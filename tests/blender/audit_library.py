@@ -209,6 +209,27 @@ def rules_file(path):
     surface(m, out, glossy(n, "Glossy BSDF", "ASHIKHMIN_SHIRLEY", 1.0).outputs[0])
     lib.expect(m, "glossy-single-scatter", "Glossy BSDF")
 
+    # A user's groups are scanned whatever their name: gloffuse knows its own by their tag
+    # and a fingerprint of their content, so neither a gloffuse-like name nor a bare tag
+    # hides a lossy lobe.
+    for material_name, group_name, tagged in (
+            ("user-group-named-gloffuse", "Gloffuse (GGX)", False),
+            ("user-group-tagged", "Brightness Correction (tagged)", True)):
+        tree, _, group_out = new_group(group_name, [], [("BSDF", "NodeSocketShader")])
+        if tagged:
+            tree["gloffuse"] = "0.1.0"
+            tree["gloffuse_content"] = "0" * 64
+        link(tree, glossy(tree.nodes, "Glossy BSDF", "GGX", 1.0).outputs[0], group_out.inputs[0])
+        m, n, out = lib.material(material_name, "loses",
+                                 "a user's group %r holding a white single-scatter GGX at r=1 "
+                                 "(~40 %%, as glossy-ggx-r1); its twin with Multiscatter GGX 1.00"
+                                 % group_name)
+        node = n.new("ShaderNodeGroup")
+        node.node_tree = tree
+        node.name = group_name
+        surface(m, out, node.outputs[0])
+        lib.expect(m, "glossy-single-scatter", group_name, "Glossy BSDF")
+
     if pre4:
         m, n, out = lib.material("glossy-sharp", "ok", "3.x's Sharp distribution is a perfect mirror")
         surface(m, out, glossy(n, "Glossy BSDF", "SHARP", 0.5).outputs[0])

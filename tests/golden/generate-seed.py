@@ -492,6 +492,9 @@ def material_node_tree(material):
 # A module of the gloffuse_blender package. Functions and constants only;
 # every version difference it meets goes through compat.py.
 # ---------------------------------------------------------------------------
+import hashlib
+import json
+
 
 
 # Layout of the generated nodes (Blender node-editor units).
@@ -599,8 +602,73 @@ def gain_at(curve, roughness):
 GLOFFUSE_TAG = "gloffuse"
 
 
+# The custom property holding a fingerprint of what gloffuse built in a group
+# (content_fingerprint), written beside the tag: the audit trusts a group only
+# while its tree is still exactly that.
+GLOFFUSE_CONTENT = "gloffuse_content"
+
+
 def is_tagged(id_block):
     return GLOFFUSE_TAG in id_block.keys()
+
+
+def _rna_value(value):
+    """A node setting or socket value as JSON: floats to 6 significant digits
+    (what a save and a reload keep), vectors as lists, enum flags sorted."""
+    if isinstance(value, float):
+        return float("%.6g" % value)
+    if isinstance(value, (bool, int, str)) or value is None:
+        return value
+    if isinstance(value, (set, frozenset)):
+        return sorted(value)
+    try:
+        return [_rna_value(v) for v in value]
+    except TypeError:
+        return repr(value)
+
+
+def _node_content(node, stack):
+    """What a node renders with: its type, mute, its own settings (every
+    writable property a plain node lacks), its unlinked inputs' values, and a
+    nested group's content or an image's name."""
+    base = {prop.identifier for prop in bpy.types.Node.bl_rna.properties}
+    settings = {prop.identifier: _rna_value(getattr(node, prop.identifier))
+                for prop in node.bl_rna.properties
+                if prop.identifier not in base and not prop.is_readonly
+                and prop.type in ("BOOLEAN", "INT", "FLOAT", "STRING", "ENUM")}
+    inputs = [[sock.identifier, _rna_value(getattr(sock, "default_value", None))]
+              for sock in node.inputs if not sock.is_linked]
+    tree = getattr(node, "node_tree", None)
+    image = getattr(node, "image", None)
+    return [node.name, node.bl_idname, bool(node.mute), settings, inputs,
+            None if tree is None else _tree_content(tree, stack),
+            None if image is None else image.name]
+
+
+def _tree_content(tree, stack=()):
+    if tree.name in stack:  # a group inside itself: Blender refuses it, never loop
+        return ["cycle", tree.name]
+    stack = stack + (tree.name,)
+    nodes = [_node_content(node, stack)
+             for node in sorted(tree.nodes, key=lambda n: n.name) if node.bl_idname != "NodeFrame"]
+    links = sorted([link.from_node.name, link.from_socket.identifier, link.to_node.name,
+                    link.to_socket.identifier, bool(link.is_muted)] for link in tree.links)
+    return [nodes, links]
+
+
+def content_fingerprint(tree):
+    """A hash of everything in `tree` that changes what it renders (nodes,
+    their settings and unconnected values, links, nested groups): any edit
+    after gloffuse built it changes it. Frames and layout are left out."""
+    text = json.dumps(_tree_content(tree), sort_keys=True)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def is_gloffuse_group(tree):
+    """A group exactly as gloffuse built it: tagged, and its content what the
+    fingerprint written at build time says (a copy edited afterwards, or a
+    user's group given the tag, is not)."""
+    return is_tagged(tree) and tree.get(GLOFFUSE_CONTENT) == content_fingerprint(tree)
 
 
 def set_aside_untagged(names):
@@ -1111,7 +1179,6 @@ def normal_group_node(tree, normal_tree, group_in, location, frame=None):
 #                                      family of the Blender this runs in
 #   validate_params(params) -> params  raise ValueError saying what is wrong
 # ---------------------------------------------------------------------------
-import json
 import math
 
 
@@ -2711,6 +2778,10 @@ def build_all(params, on_spec=None):
             if tree.name not in names:
                 raise ValueError("group_names misses the group %r it must set aside" % tree.name)
             tree[GLOFFUSE_TAG] = params.get("gloffuse_version", "")
+    # Fingerprinted once every tree is complete (a group's holds the groups it nests).
+    for _spec, trees in built:
+        for tree in trees:
+            tree[GLOFFUSE_CONTENT] = content_fingerprint(tree)
     return built
 
 
@@ -2785,6 +2856,7 @@ def sphere_mesh(name, radius, segments, rings, cut_below=None):
 import argparse
 import shutil
 import sys
+import tempfile
 import traceback
 
 
@@ -2850,13 +2922,16 @@ def save_blend(path, compress=False):
     filepaths = bpy.context.preferences.filepaths
     old_versions = filepaths.save_version
     filepaths.save_version = 0
+    said = None
     try:
         result = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False,
                                              copy=False, compress=compress)
+    except RuntimeError as error:
+        result, said = (), " ".join(str(error).split())
     finally:
         filepaths.save_version = old_versions
-    if "FINISHED" not in result or not os.path.isfile(path):
-        raise RuntimeError("Blender could not save %s" % path)
+    if said is not None or "FINISHED" not in result or not os.path.isfile(path):
+        raise RuntimeError(save_failure(path, compress, said or "the save did not finish"))
     return path
 
 
@@ -2864,6 +2939,42 @@ def shown_path(path):
     """`path` as text for the result line: a name that is not UTF-8 (surrogate-escaped in
     Python) shows U+FFFD where its bad bytes are, as JSON can hold no lone surrogate."""
     return os.fsencode(path).decode("utf-8", "replace")
+
+
+def _size(n):
+    return "%.1f MB" % (n / 1e6) if n >= 100e3 else "%d bytes" % n
+
+
+def saved_size(compress):
+    """The bytes the open file takes saved (a copy written to a temporary
+    folder and removed), or None when even that fails."""
+    with tempfile.TemporaryDirectory(prefix="gloffuse-size-") as directory:
+        copy = os.path.join(directory, "size.blend")
+        try:
+            bpy.ops.wm.save_as_mainfile(filepath=copy, check_existing=False, copy=True,
+                                        compress=compress)
+            return os.path.getsize(copy)
+        except (RuntimeError, OSError):
+            return None
+
+
+def save_failure(path, compress, said):
+    """Why saving `path` failed, in words. On a full disk Blender says nothing
+    to the point ("Error: Success", or "No such file or directory" for the
+    file it could not finish), so the device's free space is compared with
+    what the file takes when saved elsewhere."""
+    directory = os.path.dirname(path) or "."
+    try:
+        free = shutil.disk_usage(directory).free
+    except OSError:
+        return "Blender could not save %s (Blender said: %s)" % (path, said)
+    needed = saved_size(compress)
+    if needed is not None and needed >= free:
+        return ("no space left on the device: saving %s takes about %s, and the device holding "
+                "%s has %s free; free some space there or save elsewhere (Blender said: %s)"
+                % (path, _size(needed), directory, _size(free), said))
+    return ("Blender could not save %s (Blender said: %s); the device holding %s has %s free"
+            % (path, said, directory, _size(free)))
 
 
 def result_line(payload):
@@ -3191,7 +3302,6 @@ def render_previews(built, directory, on_preview=None):
 # parameter document as a JSON string), and ends the script with
 # main(GLOFFUSE_PARAMS).
 # ---------------------------------------------------------------------------
-import tempfile
 
 
 

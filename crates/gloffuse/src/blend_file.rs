@@ -6,9 +6,14 @@
 //! (8-byte pointers, `BLENDER-v…`) and the 32-byte form of Blender 5.0's 17-byte header
 //! (`BLENDER17-01v0500`, format 01: code, SDNA index, old pointer, then a 64-bit length).
 //! Every ID block's header carries the ID's two-letter code (`MA\0\0` for a material).
+//! A compressed .blend (3.0+) is a zstd stream of many frames (Blender writes one per
+//! 256 KiB) and a skippable frame holding their seek table: every frame is read.
 
-use std::io::{BufReader, Read};
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
+
+use ruzstd::decoding::errors::{FrameDecoderError, ReadFrameHeaderError};
+use ruzstd::decoding::{BlockDecodingStrategy, FrameDecoder};
 
 use crate::user_blend::read_up_to;
 
@@ -70,12 +75,75 @@ pub fn count_blocks(path: &Path, code: [u8; 4]) -> Result<usize, String> {
     read_up_to(&mut file, &mut magic).map_err(unreadable)?;
     let file = std::fs::File::open(path).map_err(unreadable)?;
     if magic == ZSTD_MAGIC {
-        let decoder = ruzstd::decoding::StreamingDecoder::new(BufReader::new(file))
-            .map_err(|e| format!("has a zstd stream that cannot be read ({e})"))?;
-        count_in(decoder, code)
+        count_in(Frames::new(BufReader::new(file)), code)
     } else {
         count_in(BufReader::new(file), code)
     }
+}
+
+/// The decompressed bytes of every frame of a zstd stream, one after the other, skippable
+/// frames skipped (ruzstd's `StreamingDecoder` stops after the first frame).
+struct Frames<R> {
+    source: R,
+    decoder: FrameDecoder,
+    /// A frame is being decoded (its header read).
+    in_frame: bool,
+}
+
+impl<R: BufRead> Frames<R> {
+    fn new(source: R) -> Self {
+        Frames {
+            source,
+            decoder: FrameDecoder::new(),
+            in_frame: false,
+        }
+    }
+}
+
+impl<R: BufRead> Read for Frames<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        loop {
+            if self.in_frame {
+                while self.decoder.can_collect() == 0 && !self.decoder.is_finished() {
+                    self.decoder
+                        .decode_blocks(&mut self.source, BlockDecodingStrategy::UptoBlocks(1))
+                        .map_err(unreadable_zstd)?;
+                }
+                let n = self.decoder.read(buf)?;
+                if n > 0 {
+                    return Ok(n);
+                }
+                self.in_frame = false;
+            }
+            // The stream ends between frames only.
+            if self.source.fill_buf()?.is_empty() {
+                return Ok(0);
+            }
+            match self.decoder.init(&mut self.source) {
+                Ok(()) => self.in_frame = true,
+                Err(FrameDecoderError::ReadFrameHeaderError(ReadFrameHeaderError::SkipFrame {
+                    length,
+                    ..
+                })) => {
+                    let skipped = std::io::copy(
+                        &mut (&mut self.source).take(u64::from(length)),
+                        &mut std::io::sink(),
+                    )?;
+                    if skipped != u64::from(length) {
+                        return Err(unreadable_zstd(FrameDecoderError::FailedToSkipFrame));
+                    }
+                }
+                Err(e) => return Err(unreadable_zstd(e)),
+            }
+        }
+    }
+}
+
+fn unreadable_zstd(e: FrameDecoderError) -> std::io::Error {
+    std::io::Error::other(format!("has a zstd stream that cannot be read ({e})"))
 }
 
 fn count_in(mut reader: impl Read, code: [u8; 4]) -> Result<usize, String> {
@@ -168,5 +236,37 @@ mod tests {
         assert_eq!(count_in(bytes.as_slice(), MATERIAL), Ok(1));
         assert!(layout(b"BLENDER17-02v0500").is_none());
         assert!(count_in(&b"PK\x03\x04 not a blend at all"[..], MATERIAL).is_err());
+    }
+
+    /// As Blender writes a compressed file: frames, then a skippable frame (its seek table).
+    #[test]
+    fn a_zstd_file_is_read_through_all_its_frames() {
+        use ruzstd::encoding::{CompressionLevel, compress_to_vec};
+        let mut bytes = b"BLENDER-v405".to_vec();
+        for i in 0..300 {
+            bytes.extend(block(
+                if i % 3 == 0 { b"MA\0\0" } else { b"DATA" },
+                &[7; 100],
+            ));
+        }
+        bytes.extend(block(b"ENDB", &[]));
+        let mut stream = Vec::new();
+        // Frames cut mid-block, and an empty one.
+        for part in [
+            &bytes[..5000],
+            &bytes[5000..5000],
+            &bytes[5000..20001],
+            &bytes[20001..],
+        ] {
+            stream.extend(compress_to_vec(part, CompressionLevel::Fastest));
+        }
+        stream.extend(0x184D_2A5E_u32.to_le_bytes());
+        stream.extend(6u32.to_le_bytes());
+        stream.extend(b"seek!!");
+        let file = tempfile::NamedTempFile::new().unwrap();
+        std::fs::write(file.path(), &stream).unwrap();
+        assert_eq!(count_blocks(file.path(), MATERIAL), Ok(100));
+        std::fs::write(file.path(), &stream[..stream.len() / 2]).unwrap();
+        assert!(count_blocks(file.path(), MATERIAL).is_err(), "a cut stream");
     }
 }

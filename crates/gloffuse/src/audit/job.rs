@@ -3,10 +3,10 @@
 //! (never saving it), applies the rules, renders each material beside its conserving twin
 //! in the white furnace and, when asked, saves a fixed copy.
 
+use std::collections::BTreeMap;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-
-use std::collections::BTreeMap;
+use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
@@ -28,7 +28,6 @@ struct AuditSection {
     seed: u32,
     threads: u32,
     radius_fraction: f64,
-    columns: usize,
     rules: Vec<RuleRange>,
     /// The gloffuse groups a twin may use, by mode and Blender distribution enum; the job
     /// asks for the ones it needs (`needs`) when the document holds no groups.
@@ -132,7 +131,7 @@ pub struct JobSettings<'a> {
     /// The twins' gloffuse groups, once a job has asked for them.
     pub groups: Option<&'a GenerateParams>,
     pub render: Option<RenderSettings>,
-    /// About how many materials the file holds (for the grid's shape).
+    /// About how many materials the file holds (for the timeout).
     pub materials: usize,
     /// Told the fraction of the render done (by Cycles' estimate) while it runs.
     pub on_fraction: &'a (dyn Fn(f64) + Sync),
@@ -145,9 +144,19 @@ pub struct JobRun {
     pub exr: Option<PathBuf>,
 }
 
-/// Columns of a grid of `cells` cells, about as wide as high.
-fn columns_for(cells: usize) -> usize {
-    (cells.max(1) as f64).sqrt().ceil() as usize
+/// Each material's share of an audit job's time limit: five times what bpy 4.5 took at
+/// the default settings on two shared cores (2,000 materials, scan, twins and furnace, in
+/// 13 minutes: 0.4 s each).
+const SECONDS_PER_MATERIAL: u64 = 2;
+
+/// The time limit of an audit job on a file of `materials` materials: the Blender options'
+/// timeout (what a start and a few materials need) plus [`SECONDS_PER_MATERIAL`] each, so
+/// a file of thousands of materials gets the time its materials take.
+fn job_timeout(timeout: Duration, materials: usize) -> Duration {
+    let materials = u64::try_from(materials).unwrap_or(u64::MAX);
+    timeout.saturating_add(Duration::from_secs(
+        SECONDS_PER_MATERIAL.saturating_mul(materials),
+    ))
 }
 
 /// Runs the audit job on `file` (its real path); with `fix_output`, the job also saves the
@@ -170,8 +179,6 @@ pub fn run_job(
         seed: render.seed,
         threads: 0,
         radius_fraction: render.radius_fraction,
-        // A material and its twin per material, at most.
-        columns: columns_for(2 * s.materials),
         rules: ranges(),
         twin_names: TwinNames::new(),
     };
@@ -186,7 +193,7 @@ pub fn run_job(
         blender: s.blender,
         script: &script,
         args: job_args(file, fix_output, compress),
-        timeout: s.options.timeout,
+        timeout: job_timeout(s.options.timeout, s.materials),
         cancel: s.options.cancel.clone(),
         log: log.clone(),
     };
@@ -217,9 +224,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_grid_is_about_square() {
-        assert_eq!(columns_for(0), 1);
-        assert_eq!(columns_for(2), 2);
-        assert_eq!(columns_for(200), 15);
+    fn the_time_limit_grows_with_the_materials() {
+        let base = Duration::from_secs(600);
+        assert_eq!(job_timeout(base, 0), base);
+        assert_eq!(
+            job_timeout(base, 2000),
+            base + Duration::from_secs(2000 * SECONDS_PER_MATERIAL)
+        );
+        assert!(job_timeout(base, 2000) > job_timeout(base, 10));
+        assert_eq!(job_timeout(Duration::MAX, usize::MAX), Duration::MAX);
     }
 }

@@ -1,9 +1,10 @@
 //! From a job's result and its rendered grid to verdicts: each material's brightness and its
 //! twin's, its findings worded from the catalogue, and `ok`, `loses`, `creates` or `error`.
 
-use super::job::{JobFinding, JobMaterial};
+use super::job::{JobFinding, JobMaterial, JobRun};
 use super::rules::{Effect, Predictor, rule};
 use super::verdict::{AuditJudging, AuditedMaterial, Brightness, Finding, Verdict};
+use crate::Error;
 use crate::verify::image::Rgba;
 use crate::verify::stats::{SphereStats, sphere_stats};
 
@@ -23,6 +24,39 @@ pub struct Grid<'a> {
     pub columns: usize,
     pub cell: usize,
     pub radius_fraction: f64,
+}
+
+/// Checks that the job's grid (its columns, every material's cells) is the image's: as
+/// wide as its columns of `cell` pixels, every cell inside. A job whose result and image
+/// disagree is the file's error, never judged (a cell outside the image would read as a
+/// sphere that rendered nothing).
+pub fn check_grid(job: &JobRun, image: Option<&Rgba>, cell: u32) -> Result<(), Error> {
+    let Some(image) = image else {
+        return Ok(());
+    };
+    let columns = job.result.columns.unwrap_or(0);
+    let outside = job
+        .result
+        .materials
+        .iter()
+        .flat_map(|m| [m.cell, m.twin_cell])
+        .flatten()
+        .find(|&i| image.cell_origin(columns, cell as usize, i).is_none());
+    let what = match outside {
+        Some(index) => format!("cell {index}"),
+        None if columns.checked_mul(cell as usize) != Some(image.width) => "the width".into(),
+        None => return Ok(()),
+    };
+    Err(Error::Blender {
+        message: format!(
+            "the furnace image ({} x {} px) does not hold {what} of the job's grid ({columns} \
+             columns of {cell} px)",
+            image.width, image.height
+        )
+        .into(),
+        log: Some(job.log.clone()),
+        command: None,
+    })
 }
 
 impl Grid<'_> {
@@ -243,4 +277,42 @@ fn by_furnace(
             pct(twin.mean)
         ),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A job whose grid its image does not hold is the file's error.
+    #[test]
+    fn a_cell_outside_the_image_is_an_error() {
+        let job = |columns: usize, cells: &[(usize, usize)]| JobRun {
+            result: serde_json::from_value(serde_json::json!({
+                "columns": columns,
+                "materials": cells.iter().map(|(c, t)| serde_json::json!({
+                    "name": "m", "cell": c, "twin_cell": t
+                })).collect::<Vec<_>>(),
+            }))
+            .unwrap(),
+            log: "blender.log".into(),
+            exr: None,
+        };
+        let image = Rgba {
+            width: 64,
+            height: 32,
+            pixels: vec![[1.0; 4]; 64 * 32],
+        };
+        assert!(check_grid(&job(2, &[(0, 1), (2, 3)]), Some(&image), 32).is_err());
+        assert!(check_grid(&job(2, &[(0, 1)]), Some(&image), 32).is_ok());
+        assert!(check_grid(&job(0, &[(0, 1)]), Some(&image), 32).is_err());
+        assert!(check_grid(&job(4, &[(0, 1)]), Some(&image), 32).is_err());
+        assert!(check_grid(&job(4, &[(0, 1)]), None, 32).is_ok());
+        let message = check_grid(&job(2, &[(0, 5)]), Some(&image), 32)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.contains("64 x 32 px") && message.contains("cell 5"),
+            "{message}"
+        );
+    }
 }

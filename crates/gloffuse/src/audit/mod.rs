@@ -592,6 +592,7 @@ fn audit_file(
     let compress = fix.is_some_and(|f| f.input.compressed());
     let job = run_twinned(s, twins, &real, temp.as_deref(), compress)?;
     let image = job.exr.as_deref().map(read_grid).transpose()?;
+    judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
     let (mut file_entry, materials) = judged(file, &job, image.as_ref(), o, predictor);
     let mut installed = None;
     if let (Some(target), Some(temp), Some(fixed)) = (target, temp, &job.result.fixed) {
@@ -708,6 +709,7 @@ fn after(
 ) -> Result<Vec<AuditedMaterial>, Error> {
     let job = run_twinned(s, twins, fixed, None, false)?;
     let image = job.exr.as_deref().map(read_grid).transpose()?;
+    judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
     Ok(judged(fixed, &job, image.as_ref(), o, predictor).1)
 }
 

@@ -241,14 +241,12 @@ fn write_files(s: &mut String, files: &[String]) {
     s.push_str("</ul>\n");
 }
 
-/// The rendered cell `i` as an inline `<img>`.
+/// The rendered cell `i` as an inline `<img>` (nothing if the image does not hold it).
 fn thumbnail(rendered: &Rendered, i: usize) -> String {
     let plan = &rendered.plan;
     let cell = plan.settings.cell as usize;
-    png_tag(
-        &png::cell_image(&rendered.image, plan.columns, cell, i),
-        cell,
-    )
+    png::cell_image(&rendered.image, plan.columns, cell, i)
+        .map_or_else(String::new, |rgb| png_tag(&rgb, cell))
 }
 
 fn css([r, g, b]: [u8; 3]) -> String {

@@ -801,9 +801,10 @@ pub(super) fn write_png(rgb: &[u8], size: (u32, u32), out: &Path) -> Result<(), 
 }
 
 /// Grid cell `index` of a rendered sweep as the contact sheet shows it (over the grey
-/// background, sRGB-encoded): RGB bytes, `cell × cell`.
-pub fn cell_image(image: &Rgba, columns: usize, cell: usize, index: usize) -> Vec<u8> {
-    let (x0, y0) = ((index % columns) * cell, (index / columns) * cell);
+/// background, sRGB-encoded): RGB bytes, `cell × cell`; `None` if the image does not hold
+/// that cell ([`Rgba::cell_origin`]).
+pub fn cell_image(image: &Rgba, columns: usize, cell: usize, index: usize) -> Option<Vec<u8>> {
+    let (x0, y0) = image.cell_origin(columns, cell, index)?;
     let mut rgb = Vec::with_capacity(cell * cell * 3);
     for y in 0..cell {
         for x in 0..cell {
@@ -812,5 +813,5 @@ pub fn cell_image(image: &Rgba, columns: usize, cell: usize, index: usize) -> Ve
             rgb.extend_from_slice(&[srgb8(r + under), srgb8(g + under), srgb8(b + under)]);
         }
     }
-    rgb
+    Some(rgb)
 }

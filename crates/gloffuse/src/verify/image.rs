@@ -13,6 +13,21 @@ pub struct Rgba {
     pub pixels: Vec<[f32; 4]>,
 }
 
+impl Rgba {
+    /// The top-left pixel of cell `index` of a grid of `columns` cells of `cell` pixels when
+    /// the whole cell lies inside the image; `None` for a grid the image does not hold (no
+    /// columns, an empty cell, a cell past its edge, fewer pixels than its size says).
+    pub fn cell_origin(&self, columns: usize, cell: usize, index: usize) -> Option<(usize, usize)> {
+        let (column, row) = (index.checked_rem(columns)?, index / columns);
+        let (x0, y0) = (column.checked_mul(cell)?, row.checked_mul(cell)?);
+        let inside = cell > 0
+            && x0.checked_add(cell)? <= self.width
+            && y0.checked_add(cell)? <= self.height
+            && self.pixels.len() >= self.width.checked_mul(self.height)?;
+        inside.then_some((x0, y0))
+    }
+}
+
 pub fn read_rgba(path: &Path) -> std::result::Result<Rgba, ExrError> {
     if !path.exists() {
         return Err(ExrError::Missing {

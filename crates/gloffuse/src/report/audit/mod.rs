@@ -58,11 +58,16 @@ impl ReportDir {
     /// Writes one PNG per rendered material of `done`: as authored | twin | difference.
     pub fn add(&mut self, done: &FileDone) -> Result<(), Error> {
         for m in done.materials {
-            let picture = match (done.image, done.file.grid, m.cells) {
+            let rgb = match (done.image, done.file.grid, m.cells) {
                 (Some(image), Some((columns, cell)), Some((own, twin))) => {
+                    strip(image, columns, cell, own, twin).map(|rgb| (rgb, cell))
+                }
+                _ => None,
+            };
+            let picture = match rgb {
+                Some((rgb, cell)) => {
                     let file = picture_name(self.pictures.len());
                     let path = self.staging().join(&file);
-                    let rgb = strip(image, columns, cell, own, twin);
                     let bytes =
                         encode_png(&rgb, ((3 * cell) as u32, cell as u32)).map_err(|message| {
                             Error::Write {
@@ -227,11 +232,12 @@ fn picture_name(index: usize) -> String {
 }
 
 /// Three cells side by side, row by row: the material, its twin, and the relative
-/// difference (material − twin) / twin in false colour.
-fn strip(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize) -> Vec<u8> {
-    let a = cell_image(image, columns, cell, own);
-    let b = cell_image(image, columns, cell, twin);
-    let diff = difference(image, columns, cell, own, twin);
+/// difference (material − twin) / twin in false colour; `None` if the image does not hold
+/// both cells.
+fn strip(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize) -> Option<Vec<u8>> {
+    let a = cell_image(image, columns, cell, own)?;
+    let b = cell_image(image, columns, cell, twin)?;
+    let diff = difference(image, columns, cell, own, twin)?;
     let mut rgb = Vec::with_capacity(a.len() * 3);
     for y in 0..cell {
         let row = y * cell * 3..(y + 1) * cell * 3;
@@ -239,12 +245,18 @@ fn strip(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize) -> 
         rgb.extend_from_slice(&b[row.clone()]);
         rgb.extend_from_slice(&diff[row]);
     }
-    rgb
+    Some(rgb)
 }
 
-fn difference(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize) -> Vec<u8> {
-    let origin = |i: usize| ((i % columns) * cell, (i / columns) * cell);
-    let ((ox, oy), (tx, ty)) = (origin(own), origin(twin));
+fn difference(
+    image: &Rgba,
+    columns: usize,
+    cell: usize,
+    own: usize,
+    twin: usize,
+) -> Option<Vec<u8>> {
+    let (ox, oy) = image.cell_origin(columns, cell, own)?;
+    let (tx, ty) = image.cell_origin(columns, cell, twin)?;
     let luminance = |p: [f32; 4]| f64::from(p[0] + p[1] + p[2]) / 3.0;
     let mut rgb = Vec::with_capacity(cell * cell * 3);
     for y in 0..cell {
@@ -259,5 +271,69 @@ fn difference(image: &Rgba, columns: usize, cell: usize, own: usize, twin: usize
             rgb.extend_from_slice(&colour(d));
         }
     }
-    rgb
+    Some(rgb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::audit::{AuditedFile, AuditedMaterial};
+
+    /// A grid and an image that disagree (a job that said more cells, or columns, than its
+    /// render holds) give no picture, never a panic.
+    #[test]
+    fn a_grid_the_image_does_not_hold_gives_no_picture() {
+        let image = Rgba {
+            width: 32,
+            height: 16,
+            pixels: vec![[0.5, 0.5, 0.5, 1.0]; 32 * 16],
+        };
+        let file: AuditedFile = serde_json::from_value(serde_json::json!({
+            "file": "big.blend", "saved_by": null, "error": null, "findings": [],
+            "materials": 4, "log": null, "render_seconds": 1.0, "scan_seconds": 1.0,
+            "fixed": null
+        }))
+        .unwrap();
+        let material = |cells| {
+            let mut m: AuditedMaterial = serde_json::from_value(serde_json::json!({
+                "file": "big.blend", "material": "m", "verdict": "ok", "reason": "",
+                "mean": null, "center": null, "rim": null, "twin_mean": null,
+                "twin_center": null, "twin_rim": null, "replaced": 0, "findings": [],
+                "library": null, "after": null
+            }))
+            .unwrap();
+            m.cells = Some(cells);
+            m
+        };
+        // Cells (0, 1) fit; (2, 3) lie in a row the image lacks; 7 lies past it.
+        let materials = [material((0, 1)), material((2, 3)), material((0, 7))];
+        let dir = tempfile::tempdir().unwrap();
+        for (grid, pictures) in [
+            ((2, 16), [true, false, false]),
+            ((0, 16), [false; 3]),
+            ((2, 0), [false; 3]),
+            ((1, 32), [false; 3]),
+            ((usize::MAX, usize::MAX), [false; 3]),
+        ] {
+            let mut report = ReportDir::create(&dir.path().join(format!("{grid:?}"))).unwrap();
+            let file = AuditedFile {
+                grid: Some(grid),
+                ..file.clone()
+            };
+            report
+                .add(&FileDone {
+                    file: &file,
+                    materials: &materials,
+                    image: Some(&image),
+                })
+                .unwrap();
+            let made: Vec<bool> = report.pictures.iter().map(Option::is_some).collect();
+            assert_eq!(made, pictures, "grid {grid:?}");
+        }
+        assert!(cell_image(&image, 2, 16, 2).is_none());
+        assert_eq!(
+            cell_image(&image, 2, 16, 1).map(|c| c.len()),
+            Some(16 * 16 * 3)
+        );
+    }
 }
