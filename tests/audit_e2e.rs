@@ -350,7 +350,7 @@ fn fixed_copies_keep_their_layout_and_rules_alone_need_no_render() {
     assert_eq!(verdict("add-two-glossy"), "creates");
 }
 
-/// Bad input exits 2 before any Blender starts, naming what was wrong; `--fail-on`
+/// Bad input exits 2 before Blender is looked for, naming what was wrong; `--fail-on`
 /// chooses which verdicts fail.
 #[test]
 fn bad_input_is_refused_and_fail_on_chooses_the_failing_verdicts() {
@@ -361,7 +361,9 @@ fn bad_input_is_refused_and_fail_on_chooses_the_failing_verdicts() {
         std::fs::write(dir.path().join(f), "not read").unwrap();
     }
     let missing = dir.path().join("missing.blend");
+    let a = dir.path().join("a.blend");
     let empty = tempfile::tempdir().unwrap();
+    let itself = "a path other than the audited file (to fix the file itself, use --in-place)";
     let cases: Vec<(Vec<&std::ffi::OsStr>, String)> = vec![
         (vec![missing.as_os_str()], missing.display().to_string()),
         (vec![text.as_os_str()], "notes.txt".to_string()),
@@ -376,6 +378,28 @@ fn bad_input_is_refused_and_fail_on_chooses_the_failing_verdicts() {
                 "out.blend".as_ref(),
             ],
             "--fix-dir".to_string(),
+        ),
+        // The fix's destination is the input itself: an option error, refused before
+        // Blender is looked for (not each file's error after the audit).
+        (
+            vec![a.as_os_str(), "--fix".as_ref(), a.as_os_str()],
+            itself.to_string(),
+        ),
+        (
+            vec![
+                dir.path().as_os_str(),
+                "--fix-dir".as_ref(),
+                dir.path().as_os_str(),
+            ],
+            "to fix the files themselves, use --in-place".to_string(),
+        ),
+        (
+            vec![
+                dir.path().as_os_str(),
+                "--fix-dir".as_ref(),
+                text.as_os_str(),
+            ],
+            "a folder for the fixed copies (it is a file)".to_string(),
         ),
         (
             vec![dir.path().as_os_str(), "--fail-on".as_ref(), "bad".as_ref()],
@@ -401,6 +425,10 @@ fn bad_input_is_refused_and_fail_on_chooses_the_failing_verdicts() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(stderr.contains(&says), "{args:?}: {stderr}");
+        assert!(
+            !stderr.contains("/nonexistent/blender"),
+            "{args:?}: {stderr}"
+        );
     }
     let Some(blender) = common::blender::real_blender("4.5") else {
         return;

@@ -30,6 +30,23 @@ fn help_and_version() {
     gloffuse().arg("--help").assert().success().stdout(
         predicate::str::contains("lose energy").and(predicate::str::contains("Exit codes")),
     );
+    // Every command that exits 1 on a failing check is named beside exit code 1 (as
+    // wrapped to any width).
+    let help = gloffuse()
+        .arg("--help")
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let help = String::from_utf8(help).unwrap();
+    let words: Vec<&str> = help.split_whitespace().collect();
+    assert!(
+        words
+            .join(" ")
+            .contains("1 a check failed (verify, refresh, audit, report merge)"),
+        "{help}"
+    );
     gloffuse()
         .args(["albedo", "--help"])
         .assert()

@@ -253,6 +253,58 @@ fn the_junit_of_hostile_names_parses() {
     assert!(text.contains("\\x1b]0;pwned\\x07\\x1b[2J\nok"), "{text:?}");
 }
 
+/// A run of one file with one material that loses energy, one lobe replaced by its fix:
+/// every count the table, the page and the JUnit print agrees with its number; the JUnit's
+/// finding reads as sentences; the page's title is a banner in the verdict's colour, as
+/// verify's is, and bolds the failing count, not "ok".
+#[test]
+fn counts_of_one_read_singular_and_the_verdict_stands_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let shard = dir.path().join("s1");
+    std::fs::create_dir_all(shard.join("materials")).unwrap();
+    let mut report = shard_report(1, 1, &INPUTS[..1], &[INPUTS[0].0], "Mat");
+    report["files"][0]["fixed"] =
+        json!({"path": "/lib/fixed/a.blend", "replaced": 1, "backup": null, "after_error": null});
+    std::fs::write(shard.join("report.json"), report.to_string()).unwrap();
+    let merged = dir.path().join("merged");
+    let junit = dir.path().join("merged.xml");
+    let (code, out, err) = merge(&[
+        &shard,
+        Path::new("--report"),
+        &merged,
+        Path::new("--junit"),
+        &junit,
+    ]);
+    assert_eq!(code, 1, "{err}");
+    for shown in [
+        "Audit of 1 material in 1 file,",
+        "FAIL: 0 ok, 1 loses energy, 0 create energy, 0 errors (failing on:",
+        "(1 lobe replaced)",
+    ] {
+        assert!(out.contains(shown), "{shown}:\n{out}");
+    }
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert!(
+        xml.contains("old-glossy at Mat: single scattering. Fix: Multiscatter GGX.\n"),
+        "{xml}"
+    );
+    let page = merged.join("report.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    for shown in [
+        "<header><h1>gloffuse audit: FAIL</h1>",
+        "1 material in 1 file,",
+        "0 ok, <b>1 loses energy</b>, 0 create energy, 0 errors.",
+    ] {
+        assert!(html.contains(shown), "{shown}:\n{html}");
+    }
+    let Some(chromium) = common::browser() else {
+        return;
+    };
+    let image = common::screenshot(&chromium, &page);
+    let banner = common::pixels_of(&image, gloffuse::report::html::FAIL_COLOUR);
+    assert!(banner > 10_000, "{banner} pixels of the FAIL banner");
+}
+
 #[test]
 fn an_error_quoting_a_hostile_path_prints_it_escaped() {
     let dir = tempfile::tempdir().unwrap();

@@ -368,34 +368,8 @@ fn junit_and_html_reports_of_a_failing_check() {
     let Some(chromium) = common::browser() else {
         return;
     };
-    let shot = dir.path().join("page.png");
-    let profile = tempfile::tempdir().unwrap();
-    let run = std::process::Command::new(chromium)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--window-size=1200,900",
-        ])
-        .arg(format!("--user-data-dir={}", profile.path().display()))
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("file://{}", page.display()))
-        .output()
-        .unwrap();
-    assert!(
-        shot.exists(),
-        "no screenshot: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let image = image::open(&shot).unwrap().to_rgb8();
-    let banner = gloffuse::report::html::FAIL_COLOUR;
-    let want = [1, 3, 5].map(|i| u8::from_str_radix(&banner[i..i + 2], 16).unwrap());
-    let banner_pixels = image.pixels().filter(|p| p.0 == want).count();
+    let image = common::screenshot(&chromium, &page);
+    let banner_pixels = common::pixels_of(&image, gloffuse::report::html::FAIL_COLOUR);
     assert!(
         banner_pixels > 10_000,
         "{banner_pixels} pixels of the FAIL banner"

@@ -33,7 +33,7 @@ far darker when rough. gloffuse measures that loss by integrating exactly the BS
 evaluates, fits correction curves f(r) (the shader gain is 100/f(r)), builds Blender node groups \
 that apply them, and checks them by rendering white furnace spheres in Blender headless.
 
-Exit codes: 0 success; 1 a check failed (verify, refresh); 2 an error: bad input (the message \
+Exit codes: 0 success; 1 a check failed (verify, refresh, audit, report merge); 2 an error: bad input (the message \
 names the flag or file and what would be right), no Blender found (it says where gloffuse \
 looked and how to point at one), Blender failed or timed out (the message quotes its log, \
 names the log file and prints the command to rerun it), or an output could not be written \

@@ -307,8 +307,11 @@ fn bench(b: &args::BenchArgs, out: &mut dyn Write, progress: &dyn Progress) -> R
         let r = gloffuse::bench::bench(&b.options(), progress)?;
         writeln!(
             out,
-            "{} spheres: one Blender process {:.1} s, one process per sphere {:.1} s: {:.1}× faster",
-            r.spheres, r.one_process_seconds, r.per_sphere_seconds, r.ratio
+            "{}: one Blender process {:.1} s, one process per sphere {:.1} s: {:.1}× faster",
+            gloffuse::plural::count(r.spheres, "sphere", "spheres"),
+            r.one_process_seconds,
+            r.per_sphere_seconds,
+            r.ratio
         )?;
     }
     Ok(Outcome::Success)

@@ -8,6 +8,7 @@ use gloffuse::fit::coefficients::Entry;
 use gloffuse::fit::{ColorSpace, Curve, Shown, Target, Variable, Weighting};
 use gloffuse::generate::Generated;
 use gloffuse::lut::LutSummary;
+use gloffuse::plural::count;
 use gloffuse::refresh::Refreshed;
 use gloffuse::report::escape::terminal;
 use gloffuse::verify::VerifyReport;
@@ -410,9 +411,9 @@ pub fn bench_audit(r: &gloffuse::bench::audit::AuditBenchResult) -> String {
         .map(|t| t.materials_per_second)
         .fold(f64::NAN, f64::max);
     s.push_str(&format!(
-        "\none process per material ({} materials): {:.1} s, {:.2} materials/s \
+        "\none process per material ({}): {:.1} s, {:.2} materials/s \
          (one process per file is {:.1}× faster at its best)\n",
-        p.materials,
+        count(p.materials, "material", "materials"),
         p.seconds,
         p.materials_per_second,
         best / p.materials_per_second
@@ -422,17 +423,17 @@ pub fn bench_audit(r: &gloffuse::bench::audit::AuditBenchResult) -> String {
 
 pub fn bench_shards(r: &gloffuse::bench::shards::ShardBenchResult) -> String {
     format!(
-        "sharded audit in Blender {} ({} px, {} spp): {} files of {} materials\n\
-         \n  one run:            {:>7.1} s\n  {} shards at once:   {:>7.1} s   {:.2}× faster\n\
+        "sharded audit in Blender {} ({} px, {} spp): {} of {}\n\
+         \n  one run:            {:>7.1} s\n  {} at once:   {:>7.1} s   {:.2}× faster\n\
          \ncost model: a file takes {:.2} s to start (Blender and the twins' tables) plus \
          {:.3} s per material\n",
         r.blender_version,
         r.cell,
         r.samples,
-        r.files,
-        r.materials_per_file,
+        count(r.files, "file", "files"),
+        count(r.materials_per_file, "material", "materials"),
         r.one_run_seconds,
-        r.shards,
+        count(r.shards, "shard", "shards"),
         r.sharded_seconds,
         r.speedup,
         r.start_seconds,

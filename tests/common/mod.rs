@@ -51,3 +51,39 @@ pub fn browser() -> Option<std::path::PathBuf> {
     eprintln!("skipped (GLOFFUSE_SKIP_BROWSER_TESTS=1): {why}");
     None
 }
+
+/// `page` as headless `chromium` draws it in a 1200 × 900 window.
+pub fn screenshot(chromium: &std::path::Path, page: &std::path::Path) -> image::RgbImage {
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("page.png");
+    let profile = dir.path().join("profile");
+    let run = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--window-size=1200,900",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .unwrap();
+    assert!(
+        shot.exists(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    image::open(&shot).unwrap().to_rgb8()
+}
+
+/// How many of `image`'s pixels are exactly `colour` (`#rrggbb`).
+pub fn pixels_of(image: &image::RgbImage, colour: &str) -> usize {
+    let want = [1, 3, 5].map(|i| u8::from_str_radix(&colour[i..i + 2], 16).unwrap());
+    image.pixels().filter(|p| p.0 == want).count()
+}

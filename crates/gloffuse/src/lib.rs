@@ -4,10 +4,11 @@
 //! `gloffuse-physics` crate) → [`fit`] (curves and the coefficients file) → [`generate`]
 //! (the node groups) → [`verify`] (furnace renders and the verdict) → [`report`] (renderers
 //! of the verdict). [`albedo`], [`lut`], [`refresh`] and [`bench`] are commands composed of
-//! those stages; [`blender`] runs Blender, [`output`] writes the files the user names and
-//! [`user_blend`] changes a user's .blend in place. The library returns data and never prints or
-//! parses flags: long work reports through [`progress::Progress`], and errors name their
-//! input by a typed [`Field`]. See `docs/ARCHITECTURE.md`.
+//! those stages; [`blender`] runs Blender, [`output`] writes the files the user names,
+//! [`user_blend`] changes a user's .blend in place and [`plural`] says counts in words. The
+//! library returns data and never prints or parses flags: long work reports through
+//! [`progress::Progress`], and errors name their input by a typed [`Field`]. See
+//! `docs/ARCHITECTURE.md`.
 
 pub use gloffuse_physics::{error, measure, progress};
 
@@ -21,6 +22,7 @@ pub mod fit;
 pub mod generate;
 pub mod lut;
 pub mod output;
+pub mod plural;
 pub mod refresh;
 pub mod report;
 pub mod shard;

@@ -138,9 +138,9 @@ pub fn slurm_job(a: &SlurmArgs, out: &mut dyn Write) -> Result<Outcome> {
     } else {
         writeln!(
             out,
-            "submitted: audit array job {audit} ({} shards), merge job {merge}; the merged report \
+            "submitted: audit array job {audit} ({}), merge job {merge}; the merged report \
              will be in {}",
-            job.shards,
+            gloffuse::plural::count(job.shards, "shard", "shards"),
             merged.display()
         )?;
     }

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use super::file_costs;
 use super::verdict::{AuditReport, AuditedFile, ShardRun};
+use crate::plural::count;
 use crate::shard::{assign, in_order};
 use crate::{Error, Field, Hint};
 
@@ -172,8 +173,8 @@ fn difference(first: &AuditReport, r: &AuditReport) -> Option<String> {
     }
     if b != a {
         return Some(format!(
-            "its input files differ ({} files, the other {}, or their names or material counts)",
-            b.len(),
+            "its input files differ ({}, the other {}, or their names or material counts)",
+            count(b.len(), "file", "files"),
             a.len()
         ));
     }
@@ -207,11 +208,11 @@ fn check_part(
         Field::ShardReport,
         path.display(),
         format!(
-            "shard {}'s own files as the split gives them ({} files); it holds {} files, \
-             not all of them its own: was it edited, or made by another gloffuse?",
+            "shard {}'s own files as the split gives them ({}); it holds {}, not all of \
+             them its own: was it edited, or made by another gloffuse?",
             k + 1,
-            expected.len(),
-            held.len()
+            count(expected.len(), "file", "files"),
+            count(held.len(), "file", "files")
         ),
     ))
 }

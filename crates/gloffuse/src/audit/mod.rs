@@ -27,6 +27,7 @@ use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Engine};
 use crate::output::{check_destination, temp_beside};
+use crate::plural::count;
 use crate::progress::Progress;
 use crate::shard::Shard;
 use crate::user_blend::{LockedBlend, UserBlend, read_header};
@@ -116,6 +117,7 @@ fn checked_files(o: &AuditOptions) -> Result<Vec<PathBuf>, Error> {
     let files = files::blend_files(&o.paths)?;
     check_fix_inputs(o, &files)?;
     check_fix_dir_names(o, &files)?;
+    check_fix_not_input(o, &files)?;
     Ok(files)
 }
 
@@ -134,8 +136,9 @@ fn audit_files(
     let total: usize = counts.iter().sum();
     progress.begin(
         &format!(
-            "auditing {total} materials in {} files with Blender {}",
-            files.len(),
+            "auditing {} in {} with Blender {}",
+            count(total, "material", "materials"),
+            count(files.len(), "file", "files"),
             blender.version_string
         ),
         total as u64,
@@ -323,8 +326,18 @@ fn check(o: &AuditOptions) -> Result<(), Error> {
             ));
         }
     }
-    if let FixTarget::File(out) = &o.fix {
-        check_destination(out)?;
+    match &o.fix {
+        FixTarget::File(out) => {
+            check_destination(out)?;
+        }
+        FixTarget::Dir(dir) if dir.exists() && !dir.is_dir() => {
+            return Err(Error::input(
+                Field::FixDir,
+                dir.display(),
+                "a folder for the fixed copies (it is a file)",
+            ));
+        }
+        _ => {}
     }
     Ok(())
 }
@@ -375,6 +388,40 @@ fn check_fix_dir_names(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error>
     Ok(())
 }
 
+/// A fixed copy never replaces its input (`--fix x.blend` of x.blend, `--fix-dir` of the
+/// folder audited): that is `--in-place`, which keeps a backup and takes the file's lock.
+fn check_fix_not_input(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
+    let real = |p: &Path| std::fs::canonicalize(p).ok();
+    for file in files {
+        let (field, given, dest) = match &o.fix {
+            FixTarget::File(out) => (Field::Fix, out, out.clone()),
+            FixTarget::Dir(dir) => (
+                Field::FixDir,
+                dir,
+                dir.join(relative_to_root(file, &o.paths)),
+            ),
+            FixTarget::None | FixTarget::InPlace => return Ok(()),
+        };
+        if real(&dest).is_some_and(|d| real(file) == Some(d)) {
+            let expected = match &o.fix {
+                // The path goes in as text: a `{}` in a file name is no template.
+                FixTarget::Dir(_) => Hint::text(format!(
+                    "a folder where no fixed copy is written over its input ({} would be; to \
+                     fix the files themselves, use ",
+                    file.display()
+                ))
+                .then(Hint::new("{})", [Field::InPlace])),
+                _ => Hint::new(
+                    "a path other than the audited file (to fix the file itself, use {})",
+                    [Field::InPlace],
+                ),
+            };
+            return Err(Error::input(field, given.display(), expected));
+        }
+    }
+    Ok(())
+}
+
 /// How one file's fix is written.
 struct FixPlan {
     /// The input, checked (its header: version and compression).
@@ -385,9 +432,9 @@ struct FixPlan {
     began: std::time::SystemTime,
 }
 
-/// Each file's fix plan, checked before any render: never the input itself as a copy, and
-/// no file saved by a newer Blender unless a downgrade is allowed. A file that cannot be
-/// fixed is that file's error: the others are audited and fixed all the same.
+/// Each file's fix plan, checked before any render: no file saved by a newer Blender unless
+/// a downgrade is allowed. A file that cannot be fixed is that file's error: the others are
+/// audited and fixed all the same.
 fn fix_targets(
     o: &AuditOptions,
     files: &[PathBuf],
@@ -409,18 +456,6 @@ fn fix_targets(
                 FixTarget::Dir(dir) => Some(dir.join(relative_to_root(file, &o.paths))),
                 _ => None,
             };
-            if let Some(dest) = &dest
-                && std::fs::canonicalize(dest).is_ok_and(|d| d == input.real)
-            {
-                return Err(Error::input(
-                    field,
-                    dest.display(),
-                    Hint::new(
-                        "a path other than the audited file (to fix the file itself, use {})",
-                        [Field::InPlace],
-                    ),
-                ));
-            }
             Ok(Some(FixPlan { input, dest, began }))
         })
         .collect()

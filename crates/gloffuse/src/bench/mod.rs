@@ -11,6 +11,7 @@ use crate::Error;
 use crate::blender::BlenderOptions;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Distribution, Engine, Roughness};
+use crate::plural::count;
 use crate::progress::{Progress, Quiet};
 use crate::verify::{Plan, RenderSettings, default_roughness, render};
 
@@ -63,8 +64,8 @@ pub fn bench(b: &BenchOptions, progress: &dyn Progress) -> Result<BenchResult, E
     )?;
     let one = start.elapsed().as_secs_f64();
     progress.notice(&format!(
-        "one process: {} spheres in {one:.1} s",
-        plan.cells.len()
+        "one process: {} in {one:.1} s",
+        count(plan.cells.len(), "sphere", "spheres")
     ));
     progress.begin("one process per sphere", plan.cells.len() as u64);
     let start = Instant::now();

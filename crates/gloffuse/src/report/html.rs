@@ -14,17 +14,32 @@ use crate::verify::{Rendered, Row, VerifyReport, reference_label};
 pub const PASS_COLOUR: &str = "#1b7a2f";
 pub const FAIL_COLOUR: &str = "#b3261e";
 
+/// The style every report page starts with (verify's, audit's): the page, and its banner
+/// in the verdict's colour.
+pub(crate) fn page_css(pass: bool) -> String {
+    let banner = if pass { PASS_COLOUR } else { FAIL_COLOUR };
+    format!(
+        "body {{ font: 14px/1.4 sans-serif; margin: 0; color: #222; background: #fafafa; }}\n\
+         header {{ background: {banner}; color: white; padding: 16px 24px; }}\n\
+         header h1 {{ margin: 0 0 4px; font-size: 22px; }}\n\
+         main {{ padding: 8px 24px 32px; }}\n"
+    )
+}
+
+/// The banner: `title` (text) over `detail` (HTML); it opens `<main>`.
+pub(crate) fn banner(title: &str, detail: &str) -> String {
+    format!(
+        "<header><h1>{}</h1><div>{detail}</div></header><main>\n",
+        escape(title)
+    )
+}
+
 /// `rerun` is the command line that reproduces the whole check (the CLI passes its own);
 /// `files` are the report's other files, linked by name.
 pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[String]) -> String {
     let verdict = if report.pass { "PASS" } else { "FAIL" };
-    let banner = if report.pass {
-        PASS_COLOUR
-    } else {
-        FAIL_COLOUR
-    };
     let mut s = String::new();
-    write_head(&mut s, verdict, banner);
+    write_head(&mut s, verdict, report.pass);
     write_banner(&mut s, report);
     write_thresholds(&mut s, report);
     write_rerun(&mut s, report, rerun);
@@ -37,15 +52,11 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
 }
 
 /// The document's start: its title and the style sheet, up to the opening `<body>`.
-fn write_head(s: &mut String, verdict: &str, banner: &str) {
+fn write_head(s: &mut String, verdict: &str, pass: bool) {
     let _ = write!(
         s,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
-         <title>gloffuse verify: {verdict}</title>\n<style>\n\
-         body {{ font: 14px/1.4 sans-serif; margin: 0; color: #222; background: #fafafa; }}\n\
-         header {{ background: {banner}; color: white; padding: 16px 24px; }}\n\
-         header h1 {{ margin: 0 0 4px; font-size: 22px; }}\n\
-         main {{ padding: 8px 24px 32px; }}\n\
+         <title>gloffuse verify: {verdict}</title>\n<style>\n{}\
          table {{ border-collapse: collapse; margin: 8px 0 20px; }}\n\
          th, td {{ border-bottom: 1px solid #ddd; padding: 4px 10px; text-align: right; vertical-align: middle; }}\n\
          th {{ background: #eee; }} td.name {{ text-align: left; }}\n\
@@ -57,6 +68,7 @@ fn write_head(s: &mut String, verdict: &str, banner: &str) {
          .ticks {{ display: flex; justify-content: space-between; font-size: 12px; }}\n\
          .scale {{ width: 100%; height: 14px; background: linear-gradient(to right, {}, {}, {}); }}\n\
          </style></head><body>\n",
+        page_css(pass),
         css(deviation::colour(-deviation::SCALE)),
         css(deviation::colour(0.0)),
         css(deviation::colour(deviation::SCALE)),
@@ -67,11 +79,8 @@ fn write_head(s: &mut String, verdict: &str, banner: &str) {
 /// `<main>`.
 fn write_banner(s: &mut String, report: &VerifyReport) {
     let info = &report.render;
-    let _ = writeln!(
-        s,
-        "<header><h1>{}</h1>\
-         <div>Blender {} ({} masking) · coefficients {} · {} mode · colour {} ({}) · {} px per sphere, {} spp, seed {} · rendered in {:.1} s</div></header><main>",
-        escape(&words::headline(report)),
+    let detail = format!(
+        "Blender {} ({} masking) · coefficients {} · {} mode · colour {} ({}) · {} px per sphere, {} spp, seed {} · rendered in {:.1} s",
         escape(&info.blender_version),
         escape(&info.masking),
         escape(&report.coefficients),
@@ -88,6 +97,7 @@ fn write_banner(s: &mut String, report: &VerifyReport) {
         info.seed,
         info.render_seconds,
     );
+    s.push_str(&banner(&words::headline(report), &detail));
 }
 
 /// The named thresholds the verdict applies, what they are measured against, and what

@@ -53,8 +53,8 @@ pub fn sentence(note: &Note) -> String {
             failing,
             samples,
         } => format!(
-            "{count} of the {failing} failing sphere{} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (rendered with {samples} samples per pixel; four times as many, {}, would halve a sphere's noise and cut a solid glass sphere's by about a third).",
-            if *failing == 1 { "" } else { "s" },
+            "{count} of the {} miss{} by no more than three standard errors of {} own noise beyond the tolerance: more samples may pass {} (rendered with {samples} samples per pixel; four times as many, {}, would halve a sphere's noise and cut a solid glass sphere's by about a third).",
+            crate::plural::count(*failing, "failing sphere", "failing spheres"),
             if *count == 1 { "es" } else { "" },
             if *count == 1 { "its" } else { "their" },
             if *count == 1 { "it" } else { "them" },
@@ -67,9 +67,8 @@ pub fn sentence(note: &Note) -> String {
 /// needed).`
 fn worst_sphere(verb: &str, w: &WorstSphere) -> String {
     format!(
-        " {verb}: {} sphere{}, worst {} r = {} at {:.1} % (gain {:.3}; 1/E_avg = {:.3} is needed).",
-        w.count,
-        if w.count == 1 { "" } else { "s" },
+        " {verb}: {}, worst {} r = {} at {:.1} % (gain {:.3}; 1/E_avg = {:.3} is needed).",
+        crate::plural::count(w.count, "sphere", "spheres"),
         w.distribution.label(),
         w.roughness,
         100.0 * w.brightness,

@@ -11,6 +11,7 @@ use crate::blender::{
 };
 use crate::generate::{GenerateParams, Job, Mode, assemble};
 use crate::output::write_output;
+use crate::plural::count;
 use crate::progress::Progress;
 
 /// How a sweep was rendered: which Blender, the settings, and how to rerun it.
@@ -96,8 +97,8 @@ pub fn render(
 /// Runs the render while `progress` follows it by Cycles' own estimate.
 fn run_followed(run: &Run, plan: &Plan, progress: &dyn Progress) -> Result<RunOutput, Error> {
     progress.begin_estimated(&format!(
-        "rendering {} spheres in Blender {}",
-        plan.cells.len(),
+        "rendering {} in Blender {}",
+        count(plan.cells.len(), "sphere", "spheres"),
         run.blender.version_string
     ));
     let outcome = run_following_render(run, &|e| progress.estimate(e.done, e.seconds_left));

@@ -1,42 +1,47 @@
-//! The audit verdict as one HTML page: a summary, then one card per material (failures
-//! first) with its picture (as authored | conserving twin | difference), its numbers and
-//! its findings with their fixes.
+//! The audit verdict as one HTML page: a banner in the verdict's colour (verify's) with the
+//! counts, then one card per material (failures first) with its picture (as authored |
+//! conserving twin | difference), its numbers and its findings with their fixes.
 
-use super::table::{order, pct};
+use super::table::{counts, order, pct};
 use crate::audit::{AuditReport, AuditedMaterial};
-use crate::report::html::escape;
+use crate::plural::count;
+use crate::report::html::{banner, escape, page_css};
 
 /// `pictures[i]` is material i's picture (report order), relative to the page.
 pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) -> String {
     let c = &report.counts;
-    let mut s = String::from(
+    let verdict = if report.passed { "PASS" } else { "FAIL" };
+    let mut s = format!(
         "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
-         <title>gloffuse audit</title><style>\
-         body{font:14px/1.4 system-ui,sans-serif;margin:2em;max-width:70em}\
-         .card{border:1px solid #ccc;border-radius:6px;padding:.8em;margin:.8em 0}\
-         .creates{border-left:6px solid #b2182b}.loses{border-left:6px solid #2166ac}\
-         .error{border-left:6px solid #777}.ok{border-left:6px solid #1a9850}\
-         img{image-rendering:pixelated;width:384px;display:block;margin:.4em 0}\
-         .cap{display:flex;width:384px;font-size:12px;color:#555}.cap span{flex:1;text-align:center}\
-         code{background:#f4f4f4;padding:0 .2em}</style></head><body>\n",
+         <title>gloffuse audit: {verdict}</title><style>\n{}\
+         main{{max-width:70em}}\
+         .card{{border:1px solid #ccc;border-radius:6px;padding:.8em;margin:.8em 0;background:white}}\
+         .creates{{border-left:6px solid #b2182b}}.loses{{border-left:6px solid #2166ac}}\
+         .error{{border-left:6px solid #777}}.ok{{border-left:6px solid #1a9850}}\
+         img{{image-rendering:pixelated;width:384px;display:block;margin:.4em 0}}\
+         .cap{{display:flex;width:384px;font-size:12px;color:#555}}.cap span{{flex:1;text-align:center}}\
+         code{{background:#f4f4f4;padding:0 .2em}}</style></head><body>\n",
+        page_css(report.passed)
     );
-    s.push_str(&format!(
-        "<h1>gloffuse audit: {}</h1>\n<p>{} materials in {} files, Blender {}, {} px, {} spp: \
-         <b>{} ok</b>, {} lose energy, {} create energy, {} errors. The check fails on: {}. \
-         Each picture shows the material as authored in a white furnace (a uniformly lit white \
-         world: a material that neither loses nor creates energy renders at 100 % of its \
-         colour), its energy-conserving twin, and their difference (blue: darker than the \
-         twin, red: brighter; ±5 % at full colour).</p>\n<p>Rerun: <code>{}</code></p>\n",
-        if report.passed { "PASS" } else { "FAIL" },
-        c.materials,
-        c.files,
+    // On a failing page, the counts that fail it stand out; on a passing one, none does.
+    let tally: Vec<String> = counts(report)
+        .into_iter()
+        .map(|(failing, words)| {
+            if failing {
+                format!("<b>{words}</b>")
+            } else {
+                words
+            }
+        })
+        .collect();
+    let detail = format!(
+        "{} in {}, Blender {}, {} px, {} spp: {}. The check fails on: {}.",
+        count(c.materials, "material", "materials"),
+        count(c.files, "file", "files"),
         escape(&report.blender_version),
         report.settings.cell,
         report.settings.samples,
-        c.ok,
-        c.loses,
-        c.creates,
-        c.error,
+        tally.join(", "),
         report
             .settings
             .fail_on
@@ -44,6 +49,13 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             .map(|v| v.key())
             .collect::<Vec<_>>()
             .join(", "),
+    );
+    s.push_str(&banner(&format!("gloffuse audit: {verdict}"), &detail));
+    s.push_str(&format!(
+        "<p>Each picture shows the material as authored in a white furnace (a uniformly lit \
+         white world: a material that neither loses nor creates energy renders at 100 % of its \
+         colour), its energy-conserving twin, and their difference (blue: darker than the \
+         twin, red: brighter; ±5 % at full colour).</p>\n<p>Rerun: <code>{}</code></p>\n",
         escape(rerun)
     ));
     for f in report.files.iter().filter(|f| f.error.is_some()) {
@@ -56,7 +68,7 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
     for (index, m) in order(report) {
         s.push_str(&card(m, pictures.get(index).cloned().flatten()));
     }
-    s.push_str("</body></html>\n");
+    s.push_str("</main></body></html>\n");
     s
 }
 

@@ -42,7 +42,7 @@ fn case(report: &AuditReport, m: &AuditedMaterial, rerun: &str) -> TestCase {
         let findings: Vec<String> = m
             .findings
             .iter()
-            .map(|f| format!("{} at {}: {} Fix: {}", f.rule, f.node, f.why, f.fix))
+            .map(|f| format!("{} at {}: {}. Fix: {}.", f.rule, f.node, f.why, f.fix))
             .collect();
         status.set_description(xml_text(&format!(
             "{}\nrerun: {rerun}",

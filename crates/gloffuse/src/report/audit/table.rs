@@ -4,6 +4,7 @@
 //! drive the terminal or start a line of its own.
 
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Verdict};
+use crate::plural::count;
 use crate::report::escape::terminal;
 
 /// A brightness in percent, or a dash where there is none.
@@ -21,9 +22,9 @@ pub fn order(report: &AuditReport) -> Vec<(usize, &AuditedMaterial)> {
 
 pub fn render(report: &AuditReport) -> String {
     let mut s = format!(
-        "Audit of {} materials in {} files, Blender {} ({} px, {} spp)\n\n",
-        report.counts.materials,
-        report.counts.files,
+        "Audit of {} in {}, Blender {} ({} px, {} spp)\n\n",
+        count(report.counts.materials, "material", "materials"),
+        count(report.counts.files, "file", "files"),
         terminal(&report.blender_version),
         report.settings.cell,
         report.settings.samples
@@ -63,23 +64,39 @@ pub fn render(report: &AuditReport) -> String {
     for f in &report.files {
         s.push_str(&file_lines(f));
     }
-    let c = &report.counts;
     let failing: Vec<&str> = report.settings.fail_on.iter().map(|v| v.key()).collect();
-    let unread = match c.files_failed {
+    let unread = match report.counts.files_failed {
         0 => String::new(),
-        1 => ", 1 file could not be audited".to_string(),
-        n => format!(", {n} files could not be audited"),
+        n => format!(", {} could not be audited", count(n, "file", "files")),
     };
     s.push_str(&format!(
-        "\n{}: {} ok, {} lose energy, {} create energy, {} errors{unread} (failing on: {})\n",
+        "\n{}: {}{unread} (failing on: {})\n",
         if report.passed { "PASS" } else { "FAIL" },
-        c.ok,
-        c.loses,
-        c.creates,
-        c.error,
+        counts(report).map(|(_, words)| words).join(", "),
         failing.join(", ")
     ));
     s
+}
+
+/// The materials' counts by verdict, in words (`0 ok`, `1 loses energy`, `2 errors`), each
+/// with whether it fails the check: a verdict in `--fail-on` that some material has.
+pub(super) fn counts(report: &AuditReport) -> [(bool, String); 4] {
+    let c = &report.counts;
+    [
+        (Verdict::Ok, c.ok, "ok", "ok"),
+        (Verdict::Loses, c.loses, "loses energy", "lose energy"),
+        (
+            Verdict::Creates,
+            c.creates,
+            "creates energy",
+            "create energy",
+        ),
+        (Verdict::Error, c.error, "error", "errors"),
+    ]
+    .map(|(verdict, n, one, many)| {
+        let failing = n > 0 && report.settings.fail_on.contains(&verdict);
+        (failing, count(n, one, many))
+    })
 }
 
 /// A file's error, its own findings and its fix, each on a line of its own.
@@ -98,9 +115,9 @@ fn file_lines(f: &AuditedFile) -> String {
     }
     if let Some(fixed) = &f.fixed {
         s.push_str(&format!(
-            "\nfixed   {file} → {} ({} lobes replaced)\n",
+            "\nfixed   {file} → {} ({} replaced)\n",
             terminal(&fixed.path),
-            fixed.replaced
+            count(fixed.replaced, "lobe", "lobes")
         ));
         if let Some(e) = &fixed.after_error {
             s.push_str(&format!(
