@@ -14,22 +14,7 @@ use serde_json::Value;
 
 use common::audit_library::{Expected, make_library, view_library};
 
-/// `gloffuse audit --json --no-provision --blender BLENDER ARGS`: exit code, JSON report
-/// (null if stdout holds none) and stderr.
-fn audit(blender: &Path, args: &[&std::ffi::OsStr]) -> (i32, Value, String) {
-    let out = common::gloffuse()
-        .args(["audit", "--json", "--no-provision"])
-        .args(args)
-        .arg("--blender")
-        .arg(blender)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        serde_json::from_slice(&out.stdout).unwrap_or(Value::Null),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::audit_json as audit;
 
 /// Every file below `dir` with its bytes.
 fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {

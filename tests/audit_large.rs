@@ -14,22 +14,7 @@ use gloffuse::blend_file::{MATERIAL, count_blocks};
 /// cells cannot fit in one 65,536-pixel render (64² = 4,096 cells at most).
 const MANY: usize = 2800;
 
-/// `gloffuse audit --json --no-provision --blender BLENDER ARGS`: exit code, JSON report
-/// (null if stdout holds none) and stderr.
-fn audit(blender: &Path, args: &[&std::ffi::OsStr]) -> (i32, Value, String) {
-    let out = common::gloffuse()
-        .args(["audit", "--json", "--no-provision"])
-        .args(args)
-        .arg("--blender")
-        .arg(blender)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        serde_json::from_slice(&out.stdout).unwrap_or(Value::Null),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::audit_json as audit;
 
 /// `count` materials saved compressed by `blender` as DIR/many.blend, and how many
 /// materials Blender lists when it opens the file again.

@@ -90,6 +90,11 @@ fn leftovers(dir: &Path) -> Vec<String> {
         .collect()
 }
 
+fn assert_nothing_left(dir: &Path) {
+    let left = leftovers(dir);
+    assert!(left.is_empty(), "left beside the files: {left:?}");
+}
+
 fn finish(child: Child) -> Output {
     child.wait_with_output().unwrap()
 }
@@ -164,11 +169,7 @@ fn two_in_place_audits_at_once_keep_the_original_as_blend1() {
         ["GGX", "MULTI_GGX"],
         "the file is fixed once"
     );
-    assert!(
-        leftovers(dir.path()).is_empty(),
-        "{:?}",
-        leftovers(dir.path())
-    );
+    assert_nothing_left(dir.path());
 }
 
 /// Case 2: `generate --into F` and `audit F --in-place` at once. F ends with generate's
@@ -208,11 +209,7 @@ fn generate_into_beside_an_in_place_audit_loses_nothing() {
         "generate's groups are in the file: {tagged:?}"
     );
     assert_eq!(fs::read(dir.path().join("scene.blend1")).unwrap(), original);
-    assert!(
-        leftovers(dir.path()).is_empty(),
-        "{:?}",
-        leftovers(dir.path())
-    );
+    assert_nothing_left(dir.path());
 }
 
 /// Whether a temporary save beside the files holds bytes: a job has saved its fix.
@@ -284,11 +281,7 @@ fn a_file_saved_by_another_program_meanwhile_is_left_as_it_saved_it() {
         text(&out)
     );
     assert_eq!(out.status.code(), Some(1), "{}", text(&out));
-    assert!(
-        leftovers(dir.path()).is_empty(),
-        "{:?}",
-        leftovers(dir.path())
-    );
+    assert_nothing_left(dir.path());
 }
 
 /// Case 3: a file named with a byte that is not UTF-8, beside a sibling whose name is its
@@ -450,11 +443,7 @@ fn a_library_whose_catalogs_cannot_be_replaced_is_left_as_it_was() {
         text(&second)
     );
     assert_eq!(fs::read(&catalogs).unwrap(), catalogs_before);
-    assert!(
-        leftovers(dir.path()).is_empty(),
-        "{:?}",
-        leftovers(dir.path())
-    );
+    assert_nothing_left(dir.path());
 }
 
 /// Holds the writers' lock of `file` as gloffuse takes it (the test stands in for another

@@ -30,6 +30,26 @@ pub fn verify_json(blender: &std::path::Path, args: &[&str]) -> (i32, serde_json
     )
 }
 
+/// `gloffuse audit --json --no-provision ARGS --blender BLENDER`: its exit code, the JSON
+/// report (null if stdout holds none) and stderr.
+pub fn audit_json(
+    blender: &std::path::Path,
+    args: &[&std::ffi::OsStr],
+) -> (i32, serde_json::Value, String) {
+    let out = gloffuse()
+        .args(["audit", "--json", "--no-provision"])
+        .args(args)
+        .arg("--blender")
+        .arg(blender)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        serde_json::from_slice(&out.stdout).unwrap_or(serde_json::Value::Null),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// A headless browser for the report page: `$GLOFFUSE_TEST_CHROMIUM`, else Debian's
 /// `/usr/bin/chromium` (which `scripts/test.sh` installs). A missing one fails the test
 /// unless `GLOFFUSE_SKIP_BROWSER_TESTS=1`, and then the test says what it skipped.

@@ -36,11 +36,11 @@ pub struct Wait<'a> {
 
 /// The lock file of `target`: hidden, beside it.
 pub fn lock_path(target: &Path) -> PathBuf {
-    let name = target.file_name().unwrap_or_default().to_string_lossy();
-    target
-        .parent()
-        .unwrap_or(Path::new("."))
-        .join(format!(".{name}.gloffuse-lock"))
+    // Built from the name's bytes: a name that is not UTF-8 gets a lock of its own.
+    let mut name = std::ffi::OsString::from(".");
+    name.push(target.file_name().unwrap_or_default());
+    name.push(".gloffuse-lock");
+    target.parent().unwrap_or(Path::new(".")).join(name)
 }
 
 impl FileLock {

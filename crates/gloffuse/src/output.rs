@@ -224,6 +224,22 @@ pub fn make_report_dir(dir: &Path) -> Result<(), Error> {
     }
 }
 
+/// `file` kept under a temporary name beside it, removed on drop unless persisted: a hard
+/// link (the very bytes, no copy to fail half-way), or a synced copy with its mode where
+/// the filesystem has no links. The io error says why it could not be kept.
+pub fn keep_beside(file: &Path, suffix: &str) -> Result<tempfile::TempPath, String> {
+    let slot = temp_beside(file, suffix).map_err(|e| e.to_string())?;
+    std::fs::remove_file(&slot).map_err(|e| e.to_string())?;
+    if std::fs::hard_link(file, &slot).is_err() {
+        // fs::copy gives the copy the file's permission bits.
+        std::fs::copy(file, &slot).map_err(|e| e.to_string())?;
+        std::fs::File::open(&slot)
+            .and_then(|f| f.sync_all())
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(slot)
+}
+
 /// A temporary file next to `dest`, removed on drop unless persisted.
 pub fn temp_beside(dest: &Path, suffix: &str) -> Result<tempfile::TempPath, Error> {
     let dir = match dest.parent() {

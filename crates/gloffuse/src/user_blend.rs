@@ -307,7 +307,13 @@ impl LockedBlend {
             drop(new);
             return Ok(backup);
         }
-        let old = b.keep_old()?;
+        let old = crate::output::keep_beside(&b.real, ".blend1").map_err(|e| Error::Write {
+            path: backup.clone(),
+            message: format!(
+                "cannot keep the previous version: {e}; {} is unchanged",
+                b.given.display()
+            ),
+        })?;
         std::fs::rename(&new, &b.real).map_err(|e| fail(&b.given, "cannot replace the file", e))?;
         // The new file is in place under the old name: nothing is left to clean up.
         drop(new);
@@ -328,31 +334,6 @@ impl LockedBlend {
             });
         }
         Ok(backup)
-    }
-}
-
-impl UserBlend {
-    /// The old file under a temporary name beside it: a hard link (the very bytes, no copy
-    /// to fail half-way), or a synced copy where the filesystem has no links.
-    fn keep_old(&self) -> Result<tempfile::TempPath, Error> {
-        let fail = |e: std::io::Error| Error::Write {
-            path: self.backup_path(),
-            message: format!(
-                "cannot keep the previous version: {e}; {} is unchanged",
-                self.given.display()
-            ),
-        };
-        let slot = crate::output::temp_beside(&self.real, ".blend1")?;
-        std::fs::remove_file(&slot).map_err(fail)?;
-        if std::fs::hard_link(&self.real, &slot).is_err() {
-            let mut from = std::fs::File::open(&self.real).map_err(fail)?;
-            let mut to = std::fs::File::create(&slot).map_err(fail)?;
-            std::io::copy(&mut from, &mut to).map_err(fail)?;
-            to.set_permissions(std::fs::Permissions::from_mode(self.mode))
-                .map_err(fail)?;
-            to.sync_all().map_err(fail)?;
-        }
-        Ok(slot)
     }
 }
 

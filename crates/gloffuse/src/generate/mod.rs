@@ -25,7 +25,7 @@ use crate::error::{Error, Field, Hint};
 use crate::file_lock::{FileLock, Wait};
 use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
-use crate::output::{Destination, check_destination, temp_beside, write_output};
+use crate::output::{Destination, check_destination, keep_beside, temp_beside, write_output};
 use crate::progress::Progress;
 use crate::user_blend::{LockedBlend, UserBlend, read_header};
 use blend::incomplete_blend;
@@ -656,18 +656,13 @@ impl Previous {
                 link: None,
             });
         }
-        let slot = temp_beside(real, ".blend")?;
-        let fail = |e: std::io::Error| Error::Write {
+        let link = keep_beside(real, ".blend").map_err(|e| Error::Write {
             path: real.to_path_buf(),
             message: format!("cannot keep the previous version while it is replaced: {e}"),
-        };
-        std::fs::remove_file(&slot).map_err(fail)?;
-        if std::fs::hard_link(real, &slot).is_err() {
-            std::fs::copy(real, &slot).map_err(fail)?;
-        }
+        })?;
         Ok(Previous {
             real: real.to_path_buf(),
-            link: Some(slot),
+            link: Some(link),
         })
     }
 
