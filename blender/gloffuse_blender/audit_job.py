@@ -5,13 +5,17 @@
 # The job module of the audit script: the gloffuse binary bundles it with the
 # modules it imports, after the header that defines GLOFFUSE_PARAMS, and ends
 # the script with main(GLOFFUSE_PARAMS). It opens the user's file (never
-# saving it), scans every material (audit_rules.py), optionally saves a fixed
-# copy (audit_twin.py's replacements on the real materials), then turns the
-# file's scene into the furnace (furnace.py) with each material and its
-# conserving twin on a sphere, renders once and prints one line
+# saving it), scans every material (audit_rules.py), then turns the file's
+# scene into the furnace (furnace.py): each material on a closed UV sphere of
+# its own, rendered once, then the same spheres with each material's conserving
+# twin in its place (same position, same coordinates), rendered again. It
+# prints one line
 #   GLOFFUSE_RESULT {json}
-# Rust reads the EXR back and judges. A material that cannot be audited gets
-# an error and the run goes on; a file that cannot be opened exits 1 (run_main).
+# Rust reads the two EXRs back and judges. Asked to fix (--save, with the
+# document's "fix" list of the materials Rust chose from an earlier run's
+# verdicts), the job applies those materials' replacements, saves the copy and
+# audits the copy instead. A material that cannot be audited gets an error and
+# the run goes on; a file that cannot be opened exits 1 (run_main).
 # ---------------------------------------------------------------------------
 import json
 import os
@@ -20,7 +24,7 @@ import time
 
 import bpy
 
-from .audit_rules import applicable_rules, scan_material, scan_scenes, twin_groups
+from .audit_rules import applicable_rules, scan_material, scan_scenes, twin_groups, uv_maps_named
 from .audit_twin import (
     apply_finding,
     datablock_pointers,
@@ -31,7 +35,13 @@ from .audit_twin import (
     set_aside_groups,
 )
 from .compat import blender_version_string, filter_glossy_property, material_node_tree
-from .furnace import furnace_layout, furnace_place_materials, furnace_stage, render_sweep
+from .furnace import (
+    FURNACE_UV_MAP,
+    furnace_layout,
+    furnace_place_materials,
+    furnace_stage,
+    render_sweep,
+)
 from .groups import build_all, group_names
 from .params import resolve_params
 from .runtime import (
@@ -43,11 +53,15 @@ from .runtime import (
     shown_path,
 )
 
-# Cycles' path depth in the audit: deep enough that glass and layered
-# materials lose next to nothing to the bounce limit (the twins are judged
-# against 1.0), no volumes (a furnace of surfaces).
-AUDIT_BOUNCES = {"max_bounces": 12, "diffuse_bounces": 4, "glossy_bounces": 4,
-                 "transmission_bounces": 12, "transparent_max_bounces": 8, "volume_bounces": 0}
+# Cycles' path depth in the audit: deep enough that light inside a solid glass
+# sphere, through layers of alpha and in a scattering volume loses next to
+# nothing to the bounce limit (the twins are judged against 1.0).
+AUDIT_BOUNCES = {"max_bounces": 64, "diffuse_bounces": 8, "glossy_bounces": 64,
+                 "transmission_bounces": 64, "transparent_max_bounces": 64, "volume_bounces": 16}
+
+
+# Blender holds at most 8 UV maps on a mesh.
+UV_MAPS_MAX = 8
 
 
 class AuditParamsError(ValueError):
@@ -65,12 +79,17 @@ def audit_params(document):
     section = document.get("audit")
     audit_require(isinstance(section, dict), "the document has no \"audit\" object")
     render = bool(section.get("render", True))
-    audit_require(not render or isinstance(section.get("output"), str), "\"output\" must be a path")
+    for key in ("output", "twin_output"):
+        audit_require(not render or isinstance(section.get(key), str), "%r must be a path" % key)
     audit_require(isinstance(section.get("rules"), list), "\"rules\" must be a list")
     for key in ("cell", "samples"):
         audit_require(isinstance(section.get(key), int) and section[key] >= 1,
                       "%r must be a positive integer" % key)
-    return dict(section, render=render, engine="cycles", seed=int(section.get("seed", 0)),
+    fix = section.get("fix", [])
+    audit_require(isinstance(fix, list) and all(isinstance(item, dict) for item in fix),
+                  "\"fix\" must be a list of {\"material\": index, \"scale\": number or null}")
+    return dict(section, render=render, engine="cycles", solid=True, fix=fix,
+                seed=int(section.get("seed", 0)),
                 threads=int(section.get("threads", 0)),
                 radius_fraction=float(section.get("radius_fraction", 0.9)))
 
@@ -126,17 +145,22 @@ def build_twin_groups(document):
     return before, kept
 
 
-def fix_and_save(entries, document, args, groups):
-    """Apply every replacement to the real materials (shared group trees in
-    place), drop what this run added and nothing uses, save the copy."""
+def fix_and_save(entries, document, args, groups, fix):
+    """Apply the replacements of the materials in `fix` (the document's list:
+    entry index, and the scale of an Add Shader that creates energy) to the real
+    materials (shared group trees in place), drop what this run added and
+    nothing uses, save the copy."""
+    chosen = {item["material"]: item.get("scale") for item in fix}
     built = build_twin_groups(document) if group_needs(entries, groups) else None
     replaced = materials = 0
-    for entry in entries:
+    for index, entry in enumerate(entries):
         material = entry["_material"]
         tree = material_node_tree(material)
-        if entry["error"] is not None or tree is None or material.library is not None:
+        if index not in chosen or entry["error"] is not None or tree is None \
+                or material.library is not None:
             continue  # a linked material is its library's to fix
-        count = sum(1 for item in entry["findings"] if apply_finding(tree, item))
+        findings = [dict(item, scale=chosen[index]) for item in entry["findings"]]
+        count = sum(1 for item in findings if apply_finding(tree, item))
         replaced += count
         materials += 1 if count else 0
     if built is not None:
@@ -149,9 +173,9 @@ def fix_and_save(entries, document, args, groups):
 # --- the furnace -------------------------------------------------------------------
 
 def twins_and_cells(entries):
-    """Make each material's twin and give every renderable material (and twin)
-    its grid cell, in order; returns the materials to place."""
-    cells = []
+    """Make each material's twin and give every renderable material its grid
+    cell, in order; returns the materials and their twins (None: no twin)."""
+    materials, twins = [], []
     for entry in entries:
         if entry["error"] is not None:
             continue
@@ -160,12 +184,10 @@ def twins_and_cells(entries):
         except Exception as error:
             entry["error"] = "twin failed: %s: %s" % (type(error).__name__, error)
             continue
-        entry["cell"] = len(cells)
-        cells.append(entry["_material"])
-        if twin is not None:
-            cells.append(twin)
-        entry["twin_cell"] = len(cells) - 1
-    return cells
+        entry["cell"] = len(materials)
+        materials.append(entry["_material"])
+        twins.append(twin)
+    return materials, twins
 
 
 def clear_scene(scene):
@@ -203,20 +225,63 @@ def audit_render_settings(scene):
         layer.use_solid = True
 
 
+def give_uv_maps(objects, materials, twins):
+    """Each sphere holds, beside its own UV map, every UV map its material (or
+    twin) names, all the sphere's unwrap: a glTF import's UV Map and Tangent
+    nodes name theirs, and a name the mesh lacks reads 0 everywhere."""
+    shared = {}
+    for obj, material, twin in zip(objects, materials, twins):
+        names = uv_maps_named(material) | (uv_maps_named(twin) if twin is not None else set())
+        names = tuple(sorted(names - {FURNACE_UV_MAP, ""}))[:UV_MAPS_MAX - 1]
+        if not names:
+            continue
+        if names not in shared:
+            mesh = obj.data.copy()
+            for name in names:
+                mesh.uv_layers.new(name=name, do_init=True)  # a copy of the active map
+            shared[names] = mesh
+        obj.data = shared[names]
+
+
+def show_twins(objects, twins):
+    """Put each twin on its material's sphere; spheres without a twin are not
+    rendered. Returns whether any twin is shown."""
+    for obj, twin in zip(objects, twins):
+        if twin is None:
+            obj.hide_render = True
+        else:
+            obj.material_slots[0].material = twin
+    return any(twin is not None for twin in twins)
+
+
 def furnace_render(entries, audit):
-    """Twins, the furnace in the context scene, one render. Returns (scene,
-    columns, seconds) or (None, None, 0.0) when no material can be rendered."""
-    cells = twins_and_cells(entries)
-    if not cells:
-        return None, None, 0.0
+    """Twins, the furnace in the context scene, the materials' render, then the
+    twins' on the same spheres. Returns None when no material can be rendered,
+    else {"scene", "columns", "seconds", "twin_output"}; each entry's
+    "twin_cell" is its twin's cell in the two renders stacked (the twins' below
+    the materials'), or its own cell when it has no twin."""
+    materials, twins = twins_and_cells(entries)
+    if not materials:
+        return None
     scene = bpy.context.scene
     # Laid out from the cells made, not from what gloffuse counted before.
-    columns, rows = furnace_layout(len(cells), audit["cell"])
+    columns, rows = furnace_layout(len(materials), audit["cell"])
     clear_scene(scene)
     furnace_stage(scene, audit, columns, rows)
     audit_render_settings(scene)
-    furnace_place_materials(scene, audit, cells, columns, rows)
-    return scene, columns, render_sweep(os.path.abspath(audit["output"]))
+    objects = furnace_place_materials(scene, audit, materials, columns, rows)
+    give_uv_maps(objects, materials, twins)
+    output = os.path.abspath(audit["output"])
+    seconds = render_sweep(output)
+    twin_output = None
+    if show_twins(objects, twins):
+        twin_output = os.path.abspath(audit["twin_output"])
+        seconds += render_sweep(twin_output)
+    for entry in entries:
+        if entry["cell"] is not None:
+            has_twin = twins[entry["cell"]] is not None
+            entry["twin_cell"] = entry["cell"] + (columns * rows if has_twin else 0)
+    return {"scene": scene, "columns": columns, "seconds": seconds, "twin_output": twin_output}
 
 
 # --- main ----------------------------------------------------------------------------
@@ -271,31 +336,33 @@ def audit_main(document_text):
 
     fixed = None
     if args.save:
-        fixed = fix_and_save(entries, document, args, groups)
+        fixed = fix_and_save(entries, document, args, groups, audit["fix"])
         if audit["render"]:
-            # The furnace shows the materials as authored: start again from the file.
-            open_user_file(path)
-            entries = [dict(fresh, findings=entry["findings"], error=entry["error"])
-                       for fresh, entry in zip(scan_file(rules, groups), entries)]
+            # What is judged now is the copy as saved.
+            path = open_user_file(args.save)
+            file_findings = scan_scenes(rules)
+            entries = scan_file(rules, groups)
 
-    scene, columns, seconds = None, None, 0.0
+    rendered = None
     if audit["render"]:
         if needs:
             build_twin_groups(document)
-        scene, columns, seconds = furnace_render(entries, audit)
+        rendered = furnace_render(entries, audit)
     else:
         for entry in entries:
             entry["replaced"] = sum(1 for item in entry["findings"] if has_replacement(item))
 
+    scene = rendered["scene"] if rendered is not None else None
     result = {
         "blender_version": blender_version_string(),
         "file": shown_path(path),
         "output": os.path.abspath(audit["output"]) if scene is not None else None,
+        "twin_output": rendered["twin_output"] if rendered is not None else None,
         "width": scene.render.resolution_x if scene is not None else 0,
         "height": scene.render.resolution_y if scene is not None else 0,
-        "columns": columns,
+        "columns": rendered["columns"] if rendered is not None else None,
         "scan_seconds": round(scan_seconds, 3),
-        "render_seconds": round(seconds, 3),
+        "render_seconds": round(rendered["seconds"], 3) if rendered is not None else 0.0,
         "file_findings": file_findings,
         "materials": [{key: value for key, value in entry.items() if key != "_material"}
                       for entry in entries],

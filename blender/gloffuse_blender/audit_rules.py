@@ -15,6 +15,7 @@
 #   twin_groups(audit) -> the gloffuse group names a twin may use
 #   scan_material(material, rules, groups) -> ([finding, ...], error or None)
 #   scan_scenes(rules) -> file findings (filter-glossy)
+#   uv_maps_named(material) -> the UV map names its nodes name
 # ---------------------------------------------------------------------------
 import math
 import os
@@ -31,7 +32,7 @@ GLOSSY_TYPES = ("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
 MULTISCATTER_TWIN = "Multiscatter GGX"
 CLAMP_TWIN = "clamped to 1"
 TOON_TWIN = "Smooth 0"
-ADD_TWIN = "Mix Shader (Fac 0.5)"
+ADD_TWIN = "scaled to 100 %"
 
 # Nodes that carry no reflecting closure (add-reflecting), and the colour
 # inputs that may exceed 1 (light, not albedo: color-above-one).
@@ -243,18 +244,18 @@ def rule_principled_single_scatter(node, groups):
     return [finding("principled-single-scatter", node, principled_detail(node), MULTISCATTER_TWIN)]
 
 
-def principled_is_plain_dielectric(node):
-    """Metallic, Transmission and Subsurface all constant 0: the Principled BSDF
-    is a coat over a diffuse base, which the layered group models."""
-    sockets = [node.inputs["Metallic"], principled_input(node, "transmission"),
-               principled_input(node, "subsurface")]
+def principled_without_transmission(node):
+    """Transmission and Subsurface both constant 0: the Principled BSDF is a coat
+    over a diffuse base mixed with a metal by Metallic, which the Layered group
+    and a Multiscatter GGX Glossy model (audit_twin.py)."""
+    sockets = [principled_input(node, "transmission"), principled_input(node, "subsurface")]
     return all(sock is None or constant(sock) == 0.0 for sock in sockets)
 
 
 def rule_principled_creates_energy(node, groups):
     if node.bl_idname != "ShaderNodeBsdfPrincipled":
         return []
-    twin = groups["layered"].get("GGX") if principled_is_plain_dielectric(node) else None
+    twin = groups["layered"].get("GGX") if principled_without_transmission(node) else None
     return [finding("principled-creates-energy", node, principled_detail(node), twin)]
 
 
@@ -319,12 +320,21 @@ def carries_reflection(socket, stack=()):
     return node.bl_idname.startswith("ShaderNodeBsdf") or node.bl_idname in REFLECTING_EXTRA
 
 
+def feeds_output(node):
+    """Whether `node` is what its material's active output renders as the surface
+    (through Reroutes and muted nodes)."""
+    tree = node.id_data
+    tree = getattr(tree, "node_tree", tree)  # some versions give the material itself
+    output = active_output(tree)
+    return output is not None and source_node(output.inputs["Surface"]) == node
+
+
 def rule_add_reflecting(node, groups):
     if node.bl_idname != "ShaderNodeAddShader":
         return []
     if not (carries_reflection(node.inputs[0]) and carries_reflection(node.inputs[1])):
         return []
-    return [finding("add-reflecting", node, {}, ADD_TWIN)]
+    return [finding("add-reflecting", node, {"feeds_output": feeds_output(node)}, ADD_TWIN)]
 
 
 def is_surface_shader(node):
@@ -400,6 +410,75 @@ def rule_holdout(node, groups):
     return [finding("holdout", node, {})] if node.bl_idname == "ShaderNodeHoldout" else []
 
 
+# What a material may read that the furnace's sphere cannot know: the data of
+# a specific mesh, the object it is on and where, the scene around it.
+SCENE_INPUTS = {
+    "ShaderNodeAttribute": "a mesh or object attribute",
+    "ShaderNodeVertexColor": "a colour attribute of the mesh",
+    "ShaderNodeObjectInfo": "the object (its location, colour, index or random value)",
+    "ShaderNodeParticleInfo": "particles",
+    "ShaderNodeHairInfo": "hair curves",
+    "ShaderNodePointInfo": "a point cloud",
+    "ShaderNodeWireframe": "the mesh's edges",
+    "ShaderNodeBevel": "the mesh's edges",
+    "ShaderNodeAmbientOcclusion": "the geometry around it",
+    "ShaderNodeShaderToRGB": "the scene's lights",
+    "ShaderNodeCameraData": "the camera",
+}
+POSITION_OUTPUTS = {("ShaderNodeNewGeometry", "Position"): "its place in the world",
+                    ("ShaderNodeTexCoord", "Object"): "another object's place",
+                    ("ShaderNodeTexCoord", "Camera"): "the camera",
+                    ("ShaderNodeTexCoord", "Window"): "the camera"}
+
+
+def scene_input(node):
+    """What `node` lets the material depend on beyond its shader, or None."""
+    what = SCENE_INPUTS.get(node.bl_idname)
+    if what is not None:
+        return what
+    for output in node.outputs:
+        what = POSITION_OUTPUTS.get((node.bl_idname, output.name))
+        if what is None or not output.is_linked:
+            continue
+        if (node.bl_idname, output.name) == ("ShaderNodeTexCoord", "Object") \
+                and getattr(node, "object", None) is None:
+            continue  # its own object's coordinates: the sphere's
+        return what
+    return None
+
+
+def rule_depends_on_scene(node, groups):
+    what = scene_input(node)
+    if what is None:
+        return []
+    detail = {"reads": what}
+    for key in ("attribute_name", "layer_name"):
+        if getattr(node, key, ""):
+            detail["name"] = getattr(node, key)
+    return [finding("depends-on-scene", node, detail)]
+
+
+UV_MAP_NODES = (("ShaderNodeUVMap", "uv_map"), ("ShaderNodeNormalMap", "uv_map"),
+                ("ShaderNodeTangent", "uv_map"))
+
+
+def uv_maps_named(material, stack=()):
+    """The UV map names the nodes of `material` (or of a node group, nested
+    groups included) name: UV Map, Normal Map, Tangent."""
+    tree = material if isinstance(material, bpy.types.NodeTree) else material_node_tree(material)
+    names = set()
+    if tree is None or tree.name in stack:
+        return names
+    for node in tree.nodes:
+        for idname, key in UV_MAP_NODES:
+            if node.bl_idname == idname and getattr(node, key, ""):
+                names.add(getattr(node, key))
+        group = getattr(node, "node_tree", None) if node.bl_idname == "ShaderNodeGroup" else None
+        if group is not None:
+            names |= uv_maps_named(group, stack + (tree.name,))
+    return names
+
+
 def rule_unknown_node(node, groups):
     idname = node.bl_idname
     no_tree = idname == "ShaderNodeGroup" and node.node_tree is None
@@ -425,6 +504,7 @@ NODE_RULES = (
     rule_linked_group,
     rule_emission,
     rule_holdout,
+    rule_depends_on_scene,
     rule_unknown_node,
 )
 

@@ -2,8 +2,9 @@
 # gloffuse audit_twin.py: what `gloffuse audit` puts in place of a flagged
 # node. One finding's replacement applied to a node tree: Multiscatter GGX on
 # the node itself, a gloffuse group node in its place (inputs copied, outputs
-# relinked), a Mix Shader for an Add Shader, a colour clamped to 1, a Toon's
-# Smooth set to 0. The twin of a material is its copy with every replacement
+# relinked), an Add Shader that creates energy scaled back to 100 % (only in a
+# fix, by the scale Rust measured: a twin is rendered before it is known), a
+# colour clamped to 1, a Toon's Smooth set to 0. The twin of a material is its copy with every replacement
 # applied, and its own copies of the group trees on the way to a flagged node
 # (so no other material changes); --fix applies the same replacements to the
 # real trees in place.
@@ -18,7 +19,7 @@
 # ---------------------------------------------------------------------------
 import bpy
 
-from .audit_rules import MULTISCATTER_TWIN, layering_parts
+from .audit_rules import MULTISCATTER_TWIN, constant, layering_parts
 from .compat import material_node_tree
 
 TWIN_SUFFIX = " (gloffuse twin)"
@@ -88,10 +89,35 @@ def glossy_twin(tree, node, item):
 
 
 def principled_layered_twin(tree, node, item):
+    """The Layered group for a Principled BSDF before 4.0; where it is partly
+    metallic, a Mix Shader by its Metallic of that group and a Multiscatter GGX
+    Glossy of its Base Color (both conserve in 3.x, as its own lobes do not)."""
     ior = item["detail"].get("ior")
-    return group_in_place(tree, node, item["twin"], {
-        "Base Color": node.inputs["Base Color"], "Roughness": node.inputs["Roughness"],
-        "Normal": node.inputs["Normal"]}, {"IOR": 1.5 if ior is None else ior})
+    inputs = {"Base Color": node.inputs["Base Color"], "Roughness": node.inputs["Roughness"],
+              "Normal": node.inputs["Normal"]}
+    values = {"IOR": 1.5 if ior is None else ior}
+    metallic = node.inputs["Metallic"]
+    if constant(metallic) == 0.0:
+        return group_in_place(tree, node, item["twin"], inputs, values)
+    group = bpy.data.node_groups.get(item["twin"])
+    if group is None:
+        return False
+    layered = tree.nodes.new("ShaderNodeGroup")
+    layered.node_tree = group
+    layered.inputs["IOR"].default_value = values["IOR"]
+    metal = tree.nodes.new("ShaderNodeBsdfGlossy")
+    metal.distribution = "MULTI_GGX"
+    for name, socket in inputs.items():
+        feed(tree, layered.inputs[name], socket)
+        feed(tree, metal.inputs["Color" if name == "Base Color" else name], socket)
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    feed(tree, mix.inputs[0], metallic)
+    tree.links.new(next(s for s in layered.outputs if s.type == "SHADER"), mix.inputs[1])
+    tree.links.new(metal.outputs["BSDF"], mix.inputs[2])
+    layered.location = node.location.x - 200, node.location.y
+    metal.location = node.location.x - 200, node.location.y - 200
+    replace_node(tree, node, mix)
+    return True
 
 
 def mix_layered_twin(tree, node, item):
@@ -109,14 +135,21 @@ def mix_layered_twin(tree, node, item):
     return group_in_place(tree, node, item["twin"], inputs, values)
 
 
-def add_to_mix(tree, node, item):
+def add_scaled(tree, node, item):
+    """An Add Shader whose sum creates energy, scaled by item["scale"] (1 over
+    the brightness measured): a Mix Shader after it, with nothing on its other
+    input, passes that fraction. No scale (a twin): left as it is."""
+    scale = item.get("scale")
+    if scale is None or not 0.0 < scale < 1.0:
+        return False
     mix = tree.nodes.new("ShaderNodeMixShader")
-    mix.inputs[0].default_value = 0.5
-    for index in (0, 1):
-        link = live_link(node.inputs[index])
-        if link is not None:
-            tree.links.new(link.from_socket, mix.inputs[index + 1])
-    replace_node(tree, node, mix)
+    mix.inputs[0].default_value = 1.0 - scale
+    mix.location = node.location.x + 200, node.location.y
+    mix.parent = node.parent
+    out = next(sock for sock in node.outputs if sock.type == "SHADER")
+    for link in list(out.links):
+        tree.links.new(mix.outputs["Shader"], link.to_socket)
+    tree.links.new(out, mix.inputs[1])
     return True
 
 
@@ -144,14 +177,16 @@ REPLACEMENTS = {
     "principled-single-scatter": to_multiscatter,
     "principled-creates-energy": principled_layered_twin,
     "mix-fresnel-layering": mix_layered_twin,
-    "add-reflecting": add_to_mix,
+    "add-reflecting": add_scaled,
     "color-above-one": clamp_color,
     "toon-smooth": toon_sharp,
 }
 
 
 def has_replacement(item):
-    return item["twin"] is not None and item["rule"] in REPLACEMENTS
+    """Whether a twin replaces the finding's node (an Add Shader is only scaled by a fix)."""
+    return item["twin"] is not None and item["rule"] in REPLACEMENTS \
+        and (item["rule"] != "add-reflecting" or item.get("scale") is not None)
 
 
 # --- applying along a path -----------------------------------------------------------

@@ -358,13 +358,15 @@ def compat_png_settings(settings):
     settings.color_mode = "RGBA"
 
 
-def compat_uv_sphere(bm, radius, segments, rings):
+def compat_uv_sphere(bm, radius, segments, rings, uvs=False):
     # bmesh's create_uvsphere takes `radius` since 3.0 (`diameter`, which was
     # really a radius, before).
     try:
-        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius,
+                                  calc_uvs=uvs)
     except TypeError:
-        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, diameter=radius)
+        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, diameter=radius,
+                                  calc_uvs=uvs)
 
 
 def compat_disable_auto_smooth(mesh):

@@ -1,11 +1,14 @@
 # ---------------------------------------------------------------------------
 # gloffuse furnace.py: the white furnace the verify and refresh jobs render.
 #
-# A white world of strength 1, an orthographic camera looking down -Z at a grid
-# of white spheres (one cell per sphere, row 0 at the top of the image), each
-# sphere visible to camera rays only so that it sees nothing but the world. A
-# "solid" furnace (glass) holds whole spheres that see themselves, each at its
-# own depth so that light leaving one almost never meets another.
+# A white world of strength 1, an orthographic camera looking at a grid of
+# white spheres (one cell per sphere, row 0 at the top of the image). A plain
+# furnace looks down -Z at domes visible to camera rays only, so that each
+# sees nothing but the world. A "solid" furnace (glass, and every material the
+# audit renders) holds whole, closed UV spheres with a UV map, seen from the
+# side as an object is in a scene (the camera looks along +Y, Z up), visible
+# to every ray so that glass has an inside and volumes absorb, each at a depth
+# of its own so that light leaving one almost never meets another.
 # One Cycles or EEVEE render of the whole grid is written as a single-layer, 32-bit
 # float, ZIP-compressed OpenEXR (scene-linear RGBA, premultiplied by coverage
 # because the film is transparent). The "furnace" section of the parameter
@@ -52,17 +55,27 @@ FURNACE_ENGINES = ("cycles", "eevee")
 FURNACE_SPHERE_SEGMENTS = 128
 FURNACE_SPHERE_RINGS = 128
 
-# One world unit per grid cell; the camera sits well above the spheres.
+# A solid sphere's UV map (Blender's default name): U around the Z axis, V
+# from pole to pole, as a UV sphere Blender adds has.
+FURNACE_UV_MAP = "UVMap"
+
+# The camera sits this many grid cells in front of the spheres.
 FURNACE_CAMERA_HEIGHT = 10.0
 
 # Blender clamps a render's resolution to this many pixels a side, silently:
 # a larger grid would lose its last rows and columns.
 FURNACE_MAX_RESOLUTION = 65536
 
-# A solid furnace's sphere k sits this far below sphere k - 1: seen from one
-# sphere (radius <= 0.5) the others cover at most sum 2 r^2 / (4 (16 k)^2) =
-# 0.08 % of its sky, and they return most of that light anyway.
+# A solid furnace's sphere k sits FURNACE_SOLID_SPACING (k mod
+# FURNACE_SOLID_LEVELS) cells behind its grid cell: seen from one sphere
+# (radius <= half a cell) the spheres of other depths cover at most
+# sum 2 r^2 / (4 (16 k)^2) = 0.08 % of its sky, those of its own depth (256
+# cells or more away) less, and they return most of that light anyway. The
+# levels bound the depth to 4,080 cells (9,067 units), where a float still
+# places a vertex to 0.001 of the sphere's radius: a depth per sphere would
+# reach 71,000 units for 2,000 materials.
 FURNACE_SOLID_SPACING = 16.0
+FURNACE_SOLID_LEVELS = 256
 
 # A solid glass sphere keeps light inside for many bounces, nearly smooth
 # dense glass for hundreds (total internal reflection): the GGX group at IOR
@@ -342,18 +355,32 @@ def furnace_material(index, sphere, color):
     return material
 
 
-def furnace_camera(columns, depth):
+def furnace_unit(furnace):
+    """World units per grid cell: 1 in the plain furnace; in a solid one, what
+    makes each sphere's radius 1, as the UV sphere Blender adds (a volume's
+    density and a texture's scale are per world unit)."""
+    return 2.0 / furnace["radius_fraction"] if furnace.get("solid", False) else 1.0
+
+
+def furnace_camera(columns, solid, unit):
+    """The orthographic camera, `unit` world units per cell: looking down -Z at
+    the plain furnace's domes, or along +Y at a solid furnace's spheres (Z up)."""
     data = bpy.data.cameras.new("Gloffuse furnace camera")
     data.type = "ORTHO"
     data.sensor_fit = "HORIZONTAL"
-    data.ortho_scale = float(columns)  # one world unit per cell
+    data.ortho_scale = columns * unit
     data.shift_x = 0.0
     data.shift_y = 0.0
     data.clip_start = 0.1
-    data.clip_end = 2.0 * FURNACE_CAMERA_HEIGHT + depth
+    depth = FURNACE_SOLID_SPACING * FURNACE_SOLID_LEVELS if solid else 0.0
+    data.clip_end = (2.0 * FURNACE_CAMERA_HEIGHT + depth) * unit
     camera = bpy.data.objects.new("Gloffuse furnace camera", data)
-    camera.location = (0.0, 0.0, FURNACE_CAMERA_HEIGHT)
-    camera.rotation_euler = (0.0, 0.0, 0.0)  # looks down -Z, +Y up in the image
+    if solid:
+        camera.location = (0.0, -FURNACE_CAMERA_HEIGHT * unit, 0.0)
+        camera.rotation_euler = (0.5 * math.pi, 0.0, 0.0)  # looks along +Y, +Z up in the image
+    else:
+        camera.location = (0.0, 0.0, FURNACE_CAMERA_HEIGHT)
+        camera.rotation_euler = (0.0, 0.0, 0.0)  # looks down -Z, +Y up in the image
     return camera
 
 
@@ -419,33 +446,43 @@ def furnace_stage(scene, furnace, columns, rows):
     grid of `columns` x `rows` cells, without spheres."""
     scene.world = furnace_world()  # before the settings: EEVEE's are partly the world's
     furnace_render_settings(scene, furnace, columns, rows)
-    depth = FURNACE_SOLID_SPACING * len(furnace["spheres"]) if furnace.get("solid", False) else 0.0
-    camera = furnace_camera(columns, depth)
+    camera = furnace_camera(columns, furnace.get("solid", False), furnace_unit(furnace))
     scene.collection.objects.link(camera)
     scene.camera = camera
 
 
+def furnace_cell_location(index, columns, rows, solid, unit):
+    """Where sphere `index` sits: its grid cell (row-major, row 0 at the top of
+    the image), and in a solid furnace its depth level behind it."""
+    across = (index % columns + 0.5 - 0.5 * columns) * unit
+    up = (0.5 * rows - index // columns - 0.5) * unit
+    if not solid:
+        return (across, up, 0.0)
+    return (across, FURNACE_SOLID_SPACING * (index % FURNACE_SOLID_LEVELS) * unit, up)
+
+
 def furnace_place_materials(scene, furnace, materials, columns, rows):
-    """One sphere per material, in grid order (row-major, row 0 at the top),
-    linked to the scene's master collection: domes seen by camera rays only,
-    or in a solid furnace whole spheres seen by every ray, each
-    FURNACE_SOLID_SPACING below the one before."""
-    radius = 0.5 * furnace["radius_fraction"]
+    """One sphere per material, in grid order, linked to the scene's master
+    collection: domes seen by camera rays only, or in a solid furnace closed UV
+    spheres seen by every ray. Returns the objects, in the materials' order."""
+    unit = furnace_unit(furnace)
+    radius = 0.5 * furnace["radius_fraction"] * unit
     solid = furnace.get("solid", False)
     mesh = (sphere_mesh("Gloffuse furnace solid sphere", radius, FURNACE_SPHERE_SEGMENTS,
-                        FURNACE_SPHERE_RINGS)
+                        FURNACE_SPHERE_RINGS, uv_map=FURNACE_UV_MAP)
             if solid else furnace_sphere_mesh(radius))
+    objects = []
     for index, material in enumerate(materials):
-        column, row = index % columns, index // columns
-        depth = FURNACE_SOLID_SPACING * index if solid else 0.0
         obj = bpy.data.objects.new("Furnace sphere %03d" % index, mesh)
-        obj.location = (column + 0.5 - 0.5 * columns, 0.5 * rows - row - 0.5, -depth)
+        obj.location = furnace_cell_location(index, columns, rows, solid, unit)
         scene.collection.objects.link(obj)
         slot = obj.material_slots[0]
         slot.link = "OBJECT"
         slot.material = material
         if not solid:
             compat_camera_rays_only(obj)
+        objects.append(obj)
+    return objects
 
 
 def furnace_scene(furnace):

@@ -1,7 +1,8 @@
 //! One audit job: the parameter document for one .blend, one Blender run, and its result
 //! line read back as data. The job (`blender/gloffuse_blender/audit_job.py`) opens the file
-//! (never saving it), applies the rules, renders each material beside its conserving twin
-//! in the white furnace and, when asked, saves a fixed copy.
+//! (never saving it), applies the rules, renders each material and then its conserving
+//! twin on the same sphere in the white furnace; asked to fix, it applies the replacements
+//! of the materials it is given, saves the copy and audits the copy instead.
 
 use std::collections::BTreeMap;
 use std::ffi::OsString;
@@ -22,6 +23,8 @@ use crate::verify::RenderSettings;
 #[derive(Clone, Debug, Serialize)]
 struct AuditSection {
     output: String,
+    /// Where the twins' render goes, when any material has a twin.
+    twin_output: String,
     render: bool,
     cell: u32,
     samples: u32,
@@ -32,6 +35,16 @@ struct AuditSection {
     /// The gloffuse groups a twin may use, by mode and Blender distribution enum; the job
     /// asks for the ones it needs (`needs`) when the document holds no groups.
     twin_names: TwinNames,
+    /// With a fixed copy to save: the materials to fix.
+    fix: Vec<FixItem>,
+}
+
+/// One material a fix rewrites: its index in the job's materials, and the scale of an Add
+/// Shader that creates energy (1 over its measured brightness), if it has one.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FixItem {
+    pub material: usize,
+    pub scale: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -106,6 +119,9 @@ pub struct JobFixed {
 pub struct JobResult {
     #[serde(default)]
     pub output: Option<String>,
+    /// The twins' render, when any material has a twin: its cells follow the materials'.
+    #[serde(default)]
+    pub twin_output: Option<String>,
     #[serde(default)]
     pub columns: Option<usize>,
     #[serde(default)]
@@ -137,11 +153,13 @@ pub struct JobSettings<'a> {
     pub on_fraction: &'a (dyn Fn(f64) + Sync),
 }
 
-/// A finished job: its result, its log, and the EXR when it rendered.
+/// A finished job: its result, its log, and the EXRs when it rendered (the materials', and
+/// the twins' when any has one).
 pub struct JobRun {
     pub result: JobResult,
     pub log: PathBuf,
     pub exr: Option<PathBuf>,
+    pub twin_exr: Option<PathBuf>,
 }
 
 /// Each material's share of an audit job's time limit: five times what bpy 4.5 took at
@@ -159,20 +177,26 @@ fn job_timeout(timeout: Duration, materials: usize) -> Duration {
     ))
 }
 
-/// Runs the audit job on `file` (its real path); with `fix_output`, the job also saves the
-/// fixed copy there (compressed when `compress`). The two paths are the job's arguments,
-/// not in the document: they reach Blender byte for byte, UTF-8 or not.
-pub fn run_job(
-    s: &JobSettings,
-    file: &Path,
-    fix_output: Option<&Path>,
-    compress: bool,
-) -> Result<JobRun, Error> {
+/// Where a job saves its fixed copy, and what it fixes.
+#[derive(Clone, Copy)]
+pub struct FixOutput<'a> {
+    pub path: &'a Path,
+    /// Saved compressed (as the input was).
+    pub compress: bool,
+    pub materials: &'a [FixItem],
+}
+
+/// Runs the audit job on `file` (its real path); with `fix`, the job applies the fixes,
+/// saves the copy there and audits the copy. The two paths are the job's arguments, not in
+/// the document: they reach Blender byte for byte, UTF-8 or not.
+pub fn run_job(s: &JobSettings, file: &Path, fix: Option<FixOutput>) -> Result<JobRun, Error> {
     let run_dir = runs::new_run_dir("audit")?;
     let exr = run_dir.join("audit.exr");
+    let twin_exr = run_dir.join("audit-twins.exr");
     let render = s.render.unwrap_or_default();
     let section = AuditSection {
         output: exr.to_string_lossy().into_owned(),
+        twin_output: twin_exr.to_string_lossy().into_owned(),
         render: s.render.is_some(),
         cell: render.cell,
         samples: render.samples,
@@ -181,6 +205,7 @@ pub fn run_job(
         radius_fraction: render.radius_fraction,
         rules: ranges(),
         twin_names: TwinNames::new(),
+        fix: fix.map(|f| f.materials.to_vec()).unwrap_or_default(),
     };
     let params = AuditParams {
         generate: s.groups,
@@ -192,7 +217,7 @@ pub fn run_job(
     let run = Run {
         blender: s.blender,
         script: &script,
-        args: job_args(file, fix_output, compress),
+        args: job_args(file, fix),
         timeout: job_timeout(s.options.timeout, s.materials),
         cancel: s.options.cancel.clone(),
         log: log.clone(),
@@ -204,15 +229,24 @@ pub fn run_job(
         command: None,
     })?;
     let exr = (s.render.is_some() && result.output.is_some()).then_some(exr);
-    Ok(JobRun { result, log, exr })
+    let twin_exr = exr
+        .as_ref()
+        .and(result.twin_output.as_ref())
+        .map(|_| twin_exr);
+    Ok(JobRun {
+        result,
+        log,
+        exr,
+        twin_exr,
+    })
 }
 
 /// The job's arguments: the file, and where its fixed copy goes.
-fn job_args(file: &Path, fix_output: Option<&Path>, compress: bool) -> Vec<OsString> {
+fn job_args(file: &Path, fix: Option<FixOutput>) -> Vec<OsString> {
     let mut args = vec![OsString::from("--open"), file.as_os_str().to_owned()];
-    if let Some(out) = fix_output {
-        args.extend([OsString::from("--save"), out.as_os_str().to_owned()]);
-        if compress {
+    if let Some(fix) = fix {
+        args.extend([OsString::from("--save"), fix.path.as_os_str().to_owned()]);
+        if fix.compress {
             args.push(OsString::from("--compress"));
         }
     }

@@ -1,6 +1,7 @@
 //! From a job's result and its rendered grid to verdicts: each material's brightness and its
 //! twin's, its findings worded from the catalogue, and `ok`, `loses`, `creates` or `error`.
 
+use super::fix_choice;
 use super::job::{JobFinding, JobMaterial, JobRun};
 use super::rules::{Effect, Predictor, rule};
 use super::verdict::{AuditJudging, AuditedMaterial, Brightness, Finding, Verdict};
@@ -11,9 +12,9 @@ use crate::verify::stats::{SphereStats, sphere_stats};
 /// Standard errors a difference may be off by noise alone before it counts.
 const NOISE_SIGMAS: f64 = 3.0;
 
-/// A sphere covering less of its disc than this rendered nothing to measure (a holdout, a
-/// fully transparent material).
-const MIN_COVERAGE: f64 = 0.5;
+/// A sphere less opaque than this over its disc is invisible: the world is seen through it
+/// everywhere (Alpha 0, a Transparent BSDF, a holdout), and there is nothing to judge.
+const MIN_OPACITY: f64 = 0.02;
 
 /// A mean below this, with a node the audit does not know, is that node failing to render.
 const BLACK: f64 = 0.01;
@@ -60,6 +61,8 @@ pub fn check_grid(job: &JobRun, image: Option<&Rgba>, cell: u32) -> Result<(), E
 }
 
 impl Grid<'_> {
+    /// The sphere in cell `index` as the furnace shows it (a partly transparent one with
+    /// the world seen through it); `None` when it is invisible.
     fn brightness(&self, index: usize) -> Option<Brightness> {
         let s: SphereStats = sphere_stats(
             self.image,
@@ -68,16 +71,17 @@ impl Grid<'_> {
             self.cell,
             self.radius_fraction,
         );
-        if s.coverage.is_nan() || s.coverage < MIN_COVERAGE || !s.mean.is_finite() {
+        if s.opacity.is_nan() || s.opacity < MIN_OPACITY || !s.mean.is_finite() {
             return None;
         }
         let rings = s.rings.iter().map(|r| r.mean).filter(|m| m.is_finite());
         Some(Brightness {
-            mean: s.mean,
+            mean: s.seen(),
             center: s.center,
-            rim: s.rings.last().map_or(f64::NAN, |r| r.mean),
+            rim: s.rim,
             max_ring: rings.fold(f64::NEG_INFINITY, f64::max),
             standard_error: s.standard_error,
+            opacity: s.opacity,
         })
     }
 }
@@ -132,6 +136,7 @@ pub fn judge_material(
     let (verdict, reason) = verdict(m, &findings, measured, judging);
     let own = measured.and_then(|(b, _)| b);
     let twin = measured.and_then(|(_, t)| t);
+    let fix = fix_choice::choose(verdict, &findings, m.replaced, own.zip(twin), judging);
     AuditedMaterial {
         file: file.to_string(),
         material: m.name.clone(),
@@ -144,6 +149,9 @@ pub fn judge_material(
         twin_center: twin.map(|b| b.center),
         twin_rim: twin.map(|b| b.rim),
         replaced: m.replaced,
+        no_fix: fix.clone().err(),
+        opacity: own.map(|b| b.opacity),
+        fix: fix.ok().flatten(),
         findings,
         library: m.library.clone(),
         cells,
@@ -172,25 +180,17 @@ fn verdict(
     }
 }
 
-/// A sphere the furnace could not measure: a holdout or a volume without a surface is what
-/// it is (not judged); anything else that renders nothing is an error.
+/// A sphere the furnace saw nothing of: the world shows through it everywhere. Reported,
+/// never judged (nor failed).
 fn unmeasured(findings: &[Finding]) -> (Verdict, String) {
-    match findings
-        .iter()
-        .find(|f| f.rule == "holdout" || f.rule == "volume")
-    {
-        Some(f) => (
-            Verdict::Ok,
-            format!(
-                "not judged: {} at {} leaves no surface for the furnace to measure",
-                f.rule, f.node
-            ),
-        ),
-        None => (
-            Verdict::Error,
-            "the furnace rendered nothing to measure (the sphere is transparent)".to_string(),
-        ),
-    }
+    let what = findings.iter().find(|f| f.rule == "holdout").map_or_else(
+        || "the material is transparent everywhere (Alpha 0, or a Transparent BSDF)".into(),
+        |f| format!("{} at {} cuts it out", f.rule, f.node),
+    );
+    (
+        Verdict::Ok,
+        format!("not judged: the furnace sees nothing of its sphere ({what})"),
+    )
 }
 
 /// Without a render: a creating finding creates; a losing one loses unless the integrator
@@ -211,6 +211,13 @@ fn by_rules(findings: &[Finding], judging: &AuditJudging) -> (Verdict, String) {
     }
 }
 
+/// Whether a sphere renders above 100 % by more than the tolerance and its noise, or has a
+/// ring above 100 % by more than the ring tolerance.
+pub fn creates(b: &Brightness, j: &AuditJudging) -> bool {
+    b.mean > 1.0 + j.tolerance + NOISE_SIGMAS * b.standard_error
+        || b.max_ring > 1.0 + j.ring_tolerance
+}
+
 fn by_furnace(
     findings: &[Finding],
     own: Brightness,
@@ -218,8 +225,7 @@ fn by_furnace(
     j: &AuditJudging,
 ) -> (Verdict, String) {
     let emits = findings.iter().any(|f| f.rule == "emission");
-    let mean_limit = 1.0 + j.tolerance + NOISE_SIGMAS * own.standard_error;
-    if !emits && (own.mean > mean_limit || own.max_ring > 1.0 + j.ring_tolerance) {
+    if !emits && creates(&own, j) {
         return (
             Verdict::Creates,
             format!(
@@ -230,7 +236,9 @@ fn by_furnace(
         );
     }
     let noise = NOISE_SIGMAS * own.standard_error.hypot(twin.standard_error);
-    if twin.mean - own.mean > j.tolerance + noise {
+    // A twin that creates energy itself is no conserving reference.
+    let reference = !creates(&twin, j);
+    if reference && twin.mean - own.mean > j.tolerance + noise {
         return (
             Verdict::Loses,
             format!(
@@ -255,14 +263,22 @@ fn by_furnace(
     // A loss with no conserving node to compare with is judged by the integrator alone.
     let untwinned = findings.iter().find(|f| {
         f.kind == Effect::Loses
-            && f.twin.is_none()
+            && (f.twin.is_none() || !reference)
             && f.predicted.is_none_or(|p| 1.0 - p > j.tolerance)
     });
     if let Some(f) = untwinned {
+        let why = if f.twin.is_none() {
+            "has no conserving equivalent in this Blender".to_string()
+        } else {
+            format!(
+                "loses, and its twin is no reference (it renders at {}, above 100 %)",
+                pct(twin.mean)
+            )
+        };
         return (
             Verdict::Loses,
             format!(
-                "renders at {}; {} at {} has no conserving equivalent in this Blender",
+                "renders at {}; {} at {} {why}",
                 pct(own.mean),
                 f.rule,
                 f.node
@@ -296,6 +312,7 @@ mod tests {
             .unwrap(),
             log: "blender.log".into(),
             exr: None,
+            twin_exr: None,
         };
         let image = Rgba {
             width: 64,

@@ -6,6 +6,7 @@
 //! caller and dropped before the next file starts.
 
 pub mod files;
+pub mod fix_choice;
 pub mod job;
 pub mod judge;
 pub mod merge;
@@ -34,7 +35,7 @@ use crate::user_blend::{LockedBlend, UserBlend, read_header};
 use crate::verify::RenderSettings;
 use crate::verify::image::{Rgba, read_rgba};
 use crate::{Error, Field, Hint};
-use job::{JobRun, JobSettings, run_job};
+use job::{FixItem, FixOutput, JobRun, JobSettings, run_job};
 use judge::{Grid, judge_material};
 use rules::Predictor;
 
@@ -219,8 +220,8 @@ fn files_to_audit(
     }
 }
 
-/// One file audited, its fix installed and the fixed file audited again, when asked. An
-/// error of the file's own becomes its entry; a stop (`Error::Interrupted`) is returned.
+/// One file audited, and when asked its fix made, audited and installed. An error of the
+/// file's own becomes its entry; a stop (`Error::Interrupted`) is returned.
 fn audit_one(
     settings: &JobSettings,
     twins: &mut TwinGroups,
@@ -232,25 +233,11 @@ fn audit_one(
 ) -> Result<FileAudit, Error> {
     let audited =
         fix.and_then(|fix| audit_file(settings, twins, file, fix.as_ref(), o, predictor, progress));
-    let (mut audited_file, mut materials, image, installed) = match audited {
-        Err(e @ Error::Interrupted { .. }) => return Err(e),
-        Err(e) => (failed_file(file, &e), Vec::new(), None, None),
-        Ok(ok) => ok,
-    };
-    if let (Some(fixed), Some(installed)) = (&mut audited_file.fixed, &installed) {
-        match after(settings, twins, installed, o, predictor) {
-            // Stopped after the fix was installed: it counts as written.
-            Err(Error::Interrupted { log, .. }) => {
-                return Err(Error::Interrupted {
-                    log,
-                    written: vec![installed.clone()],
-                });
-            }
-            Err(e) => fixed.after_error = Some(e.to_string()),
-            Ok(after) => attach_after(&mut materials, after),
-        }
+    match audited {
+        Err(e @ Error::Interrupted { .. }) => Err(e),
+        Err(e) => Ok((failed_file(file, &e), Vec::new(), None, None)),
+        Ok(ok) => Ok(ok),
     }
-    Ok((audited_file, materials, image, installed))
 }
 
 /// What a Blender start costs, in materials' audit time: the split balances each file's
@@ -534,8 +521,7 @@ fn run_twinned(
     s: &JobSettings,
     twins: &mut TwinGroups,
     file: &Path,
-    fix_output: Option<&Path>,
-    compress: bool,
+    fix: Option<FixOutput>,
 ) -> Result<JobRun, Error> {
     let first = run_job(
         &JobSettings {
@@ -543,8 +529,7 @@ fn run_twinned(
             ..*s
         },
         file,
-        fix_output,
-        compress,
+        fix,
     )?;
     if first.result.needs.is_empty() {
         return Ok(first);
@@ -556,8 +541,7 @@ fn run_twinned(
             ..*s
         },
         file,
-        fix_output,
-        compress,
+        fix,
     )?;
     if second.result.needs.is_empty() {
         Ok(second)
@@ -624,20 +608,94 @@ fn audit_file(
             )
         }
     };
-    let compress = fix.is_some_and(|f| f.input.compressed());
-    let job = run_twinned(s, twins, &real, temp.as_deref(), compress)?;
-    let image = job.exr.as_deref().map(read_grid).transpose()?;
+    let job = run_twinned(s, twins, &real, None)?;
+    let image = read_grids(&job)?;
     judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
-    let (mut file_entry, materials) = judged(file, &job, image.as_ref(), o, predictor);
+    let (mut file_entry, mut materials) = judged(file, &job, image.as_ref(), o, predictor);
     let mut installed = None;
-    if let (Some(target), Some(temp), Some(fixed)) = (target, temp, &job.result.fixed) {
+    if let (Some(target), Some(temp), Some(plan)) = (target, temp, fix) {
+        let chosen = chosen_fixes(&materials);
+        if chosen.is_empty() && matches!(target, Installing::InPlace(_)) {
+            return Ok((file_entry, materials, image, None));
+        }
         o.blender.cancel.check()?;
-        if let Some((entry, path)) = install_fix(target, temp, fixed.replaced)? {
+        let fixed = FixOutput {
+            path: &temp,
+            compress: plan.input.compressed(),
+            materials: &chosen,
+        };
+        let (replaced, after) = fix_and_audit(s, twins, &real, fixed, o, predictor)?;
+        o.blender.cancel.check()?;
+        if let Some((mut entry, path)) = install_fix(target, temp, replaced)? {
+            match after {
+                Ok(after) => attach_after(&mut materials, after),
+                Err(e) => entry.after_error = Some(e),
+            }
             file_entry.fixed = Some(entry);
             installed = Some(path);
         }
     }
     Ok((file_entry, materials, image, installed))
+}
+
+/// The fixes the judged materials call for, in the job's material order.
+fn chosen_fixes(materials: &[AuditedMaterial]) -> Vec<FixItem> {
+    materials
+        .iter()
+        .enumerate()
+        .filter_map(|(material, m)| {
+            m.fix.map(|f| FixItem {
+                material,
+                scale: f.scale,
+            })
+        })
+        .collect()
+}
+
+/// Fixes `file` into `fixed.path` and audits the copy: the lobes replaced, and the copy's
+/// materials judged (or why they could not be).
+fn fix_and_audit(
+    s: &JobSettings,
+    twins: &mut TwinGroups,
+    file: &Path,
+    fixed: FixOutput,
+    o: &AuditOptions,
+    predictor: &mut Predictor,
+) -> Result<(usize, Result<Vec<AuditedMaterial>, String>), Error> {
+    let job = run_twinned(s, twins, file, Some(fixed))?;
+    let replaced = job.result.fixed.as_ref().map_or(0, |f| f.replaced);
+    let after = read_grids(&job).and_then(|image| {
+        judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
+        Ok(judged(fixed.path, &job, image.as_ref(), o, predictor).1)
+    });
+    Ok((replaced, after.map_err(|e| e.to_string())))
+}
+
+/// The job's grid: the materials' render, with the twins' stacked below it when there is
+/// one (the job numbers the twins' cells so).
+fn read_grids(job: &JobRun) -> Result<Option<Rgba>, Error> {
+    let Some(exr) = &job.exr else {
+        return Ok(None);
+    };
+    let mut image = read_grid(exr)?;
+    if let Some(twins) = &job.twin_exr {
+        let below = read_grid(twins)?;
+        if below.width != image.width || below.height != image.height {
+            return Err(Error::Blender {
+                message: format!(
+                    "the twins' render ({} x {} px) is not the size of the materials' ({} x {} \
+                     px)",
+                    below.width, below.height, image.width, image.height
+                )
+                .into(),
+                log: Some(job.log.clone()),
+                command: None,
+            });
+        }
+        image.height += below.height;
+        image.pixels.extend(below.pixels);
+    }
+    Ok(Some(image))
 }
 
 fn read_grid(exr: &Path) -> Result<Rgba, Error> {
@@ -734,26 +792,13 @@ fn install_fix(
     Ok(Some((fixed, path)))
 }
 
-/// The fixed file audited again.
-fn after(
-    s: &JobSettings,
-    twins: &mut TwinGroups,
-    fixed: &Path,
-    o: &AuditOptions,
-    predictor: &mut Predictor,
-) -> Result<Vec<AuditedMaterial>, Error> {
-    let job = run_twinned(s, twins, fixed, None, false)?;
-    let image = job.exr.as_deref().map(read_grid).transpose()?;
-    judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
-    Ok(judged(fixed, &job, image.as_ref(), o, predictor).1)
-}
-
 fn attach_after(materials: &mut [AuditedMaterial], after: Vec<AuditedMaterial>) {
     for m in materials {
         m.after = after
             .iter()
             .find(|a| a.material == m.material)
             .map(|a| After {
+                rewritten: m.fix.is_some(),
                 verdict: a.verdict,
                 mean: a.mean,
                 findings: a.findings.len(),

@@ -141,7 +141,9 @@ pub const RULES: &[Rule] = &[
         before: None,
         why: "an Add Shader of two reflecting closures reflects the sum of both: up to twice the \
               light it receives",
-        fix: "use a Mix Shader (its factor splits the light between the two)",
+        fix: "use a Mix Shader (its factor splits the light between the two); where the Add is \
+              the material's whole surface and it renders above 100 %, a fix scales it back to \
+              100 % by the brightness measured",
     },
     Rule {
         id: "color-above-one",
@@ -211,6 +213,17 @@ pub const RULES: &[Rule] = &[
         before: None,
         why: "the material has a volume, which the furnace renders inside the sphere",
         fix: "nothing, if the volume is meant",
+    },
+    Rule {
+        id: "depends-on-scene",
+        effect: Effect::Info,
+        from: v(3, 0),
+        before: None,
+        why: "the material reads what the furnace's sphere cannot know (a mesh's attributes or \
+              vertex colours, its object, its place in the world, the camera, the geometry or \
+              lights around it): the furnace shows it with the sphere's, which may not be \
+              what it meets in its scene",
+        fix: "nothing, if that is meant; judge the material on its own object too",
     },
     Rule {
         id: "unknown-node",

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::fix_choice::MaterialFix;
 use super::rules::Effect;
 use crate::shard::Shard;
 
@@ -79,21 +80,27 @@ pub struct Finding {
     pub detail: serde_json::Value,
 }
 
-/// Furnace brightness of one sphere (1.0 = 100 %).
+/// Furnace brightness of one sphere (1.0 = 100 %), as the furnace shows it: where the
+/// material is transparent, the white world seen through it counts.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Brightness {
     pub mean: f64,
     pub center: f64,
-    /// The outermost view-cosine ring.
+    /// The grazing views: view cosine below 0.3.
     pub rim: f64,
     /// The brightest ring.
     pub max_ring: f64,
     pub standard_error: f64,
+    /// How much of the disc the material covers (1: opaque).
+    pub opacity: f64,
 }
 
 /// The after-fix audit of a material.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct After {
+    /// Whether the fix rewrote this material (a material it needed no fix for, or had no
+    /// safe fix for, is the same in the fixed file).
+    pub rewritten: bool,
     pub verdict: Verdict,
     pub mean: Option<f64>,
     pub findings: usize,
@@ -114,12 +121,22 @@ pub struct AuditedMaterial {
     pub twin_rim: Option<f64>,
     /// How many lobes the twin replaced.
     pub replaced: usize,
+    /// Why a fix leaves this material alone although its verdict fails (no safe twin).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_fix: Option<String>,
+    /// How much of its sphere's disc it covers, where rendered (below 1: partly transparent,
+    /// and the world seen through it counts to its mean).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opacity: Option<f64>,
     pub findings: Vec<Finding>,
     /// The library it is linked from, as the file writes it.
     pub library: Option<String>,
     /// Its cell and its twin's in the file's rendered grid.
     #[serde(skip)]
     pub cells: Option<(usize, usize)>,
+    /// What a fix would do to it (none: it needs none, or `no_fix` says why not).
+    #[serde(skip)]
+    pub fix: Option<MaterialFix>,
     pub after: Option<After>,
 }
 

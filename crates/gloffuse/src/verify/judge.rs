@@ -190,6 +190,8 @@ mod tests {
             standard_error: 0.001,
             center: mean,
             coverage: 0.6,
+            opacity: 1.0,
+            rim: mean,
             rings: (0..RINGS)
                 .map(|k| Ring {
                     mu: (k as f64 / RINGS as f64, (k + 1) as f64 / RINGS as f64),

@@ -156,6 +156,8 @@ mod tests {
             standard_error: 0.0,
             center: brightness,
             coverage: 0.6,
+            opacity: 1.0,
+            rim: brightness,
             rings: vec![],
         };
         Row {

@@ -3,6 +3,10 @@
 //! An orthographic view of a sphere of radius R pixels sees, at distance d from the centre,
 //! the view cosine μ = √(1 − (d/R)²); the cosines of the disc have density 2μ, so the
 //! coverage-weighted mean Σ RGB / Σ alpha is the sphere's E_avg.
+//!
+//! A sphere that lets the world through (alpha below 1 where the disc is) is seen as an
+//! opaque film would show it: what it reflects plus the white world of strength 1 seen
+//! through it, RGB + (1 − alpha) per pixel ([`SphereStats::seen`]).
 
 use serde::Serialize;
 
@@ -35,8 +39,25 @@ pub struct SphereStats {
     /// Mean of the pixels with μ ≥ 0.995 (within 10 % of the radius of the centre).
     pub center: f64,
     pub coverage: f64,
+    /// Σ alpha over the disc's area π R²: 1 for an opaque sphere, 0 for one the world is
+    /// seen through everywhere (clamped to 1: the pixel filter spreads the edge).
+    pub opacity: f64,
+    /// Σ RGB / (3 Σ alpha) over the pixels whose view cosine is below 0.3 (the outermost
+    /// ring of the disc and the edge the pixel filter spreads): the grazing-view brightness.
+    pub rim: f64,
     pub rings: Vec<Ring>,
 }
+
+impl SphereStats {
+    /// The mean as the furnace shows it: the sphere's own light over its opaque part, the
+    /// white world (1.0) over the rest of its disc. An opaque sphere's `mean`.
+    pub fn seen(&self) -> f64 {
+        self.opacity * self.mean + (1.0 - self.opacity)
+    }
+}
+
+/// The view cosine below which a pixel counts to the rim: √(1 − 0.954²) = 0.3.
+const RIM_MU: f64 = 0.3;
 
 /// Statistics of cell `index` in a grid of `columns` cells of `cell` pixels, where the
 /// sphere's diameter is `radius_fraction` of the cell.
@@ -59,6 +80,8 @@ pub fn sphere_stats(
     let mut ring_channel = [[0.0f64; 3]; RINGS];
     let mut ring_sq = [0.0f64; RINGS];
     let mut ring_n = [0usize; RINGS];
+    let (mut rim_rgb, mut rim_a) = (0.0f64, 0.0f64);
+    let rim_d = (1.0 - RIM_MU * RIM_MU).sqrt();
     for y in y0..(y0 + cell).min(img.height) {
         for x in x0..(x0 + cell).min(img.width) {
             let p = img.pixels[y * img.width + x];
@@ -71,16 +94,21 @@ pub fn sphere_stats(
             let dx = (x - x0) as f64 + 0.5 - centre;
             let dy = (y - y0) as f64 + 0.5 - centre;
             let d = (dx * dx + dy * dy).sqrt() / radius;
-            // Only pixels whose filter footprint lies inside the disc count as fully covered.
-            if d * radius < radius - 2.0 && p[3] > 0.999 {
-                let v = rgb / p[3] as f64;
+            if d >= rim_d {
+                rim_rgb += rgb;
+                rim_a += p[3] as f64;
+            }
+            // Only pixels whose filter footprint lies inside the disc count as fully
+            // covered; what alpha leaves is the white world seen through the sphere.
+            if d * radius < radius - 2.0 {
+                let v = rgb + (1.0 - p[3] as f64);
                 let mu = (1.0 - d * d).sqrt();
                 let k = ((mu * RINGS as f64) as usize).min(RINGS - 1);
                 ring_sum[k] += v;
                 ring_sq[k] += v * v;
                 ring_n[k] += 1;
                 for (c, sum) in ring_channel[k].iter_mut().enumerate() {
-                    *sum += p[c] as f64 / p[3] as f64;
+                    *sum += p[c] as f64 + (1.0 - p[3] as f64);
                 }
                 if d <= 0.1 {
                     centre_sum += v;
@@ -137,6 +165,12 @@ pub fn sphere_stats(
             f64::NAN
         },
         coverage: sum_a / (cell * cell) as f64,
+        opacity: (sum_a / (std::f64::consts::PI * radius * radius)).min(1.0),
+        rim: if rim_a > 0.0 {
+            rim_rgb / rim_a
+        } else {
+            f64::NAN
+        },
         rings,
     }
 }
