@@ -2,7 +2,7 @@
 //! counts, then one card per material (failures first) with its picture (as authored |
 //! conserving twin | difference), its numbers and its findings with their fixes.
 
-use super::table::{counts, order, pct};
+use super::table::{counts, file_findings, order, pct};
 use crate::audit::{AuditReport, AuditedMaterial};
 use crate::plural::count;
 use crate::report::html::{banner, escape, page_css};
@@ -65,6 +65,16 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             escape(f.error.as_deref().unwrap_or_default())
         ));
     }
+    for (rule, (why, files)) in file_findings(report) {
+        let names: Vec<String> = files.iter().map(|f| escape(f)).collect();
+        s.push_str(&format!(
+            "<div class=\"card\"><code>{}</code> in {}: {}.<br><small>{}</small></div>\n",
+            escape(rule),
+            count(files.len(), "file", "files"),
+            escape(why),
+            names.join(", ")
+        ));
+    }
     for (index, m) in order(report) {
         s.push_str(&card(m, pictures.get(index).cloned().flatten()));
     }
@@ -97,12 +107,23 @@ fn card(m: &AuditedMaterial, picture: Option<String>) -> String {
         pct(m.twin_center),
         pct(m.twin_rim)
     ));
-    if let Some(after) = &m.after {
+    if let Some(opacity) = m.opacity.filter(|o| *o < 0.99) {
         s.push_str(&format!(
+            "<p>It covers {} of its sphere: the white world seen through it counts.</p>\n",
+            pct(Some(opacity))
+        ));
+    }
+    if let Some(why) = &m.no_fix {
+        s.push_str(&format!("<p>{}</p>\n", escape(why)));
+    }
+    match &m.after {
+        Some(after) if after.rewritten => s.push_str(&format!(
             "<p>After the fix: {} at {}</p>\n",
             after.verdict.key(),
             pct(after.mean)
-        ));
+        )),
+        Some(_) => s.push_str("<p>Left as it was by the fix.</p>\n"),
+        None => {}
     }
     if !m.findings.is_empty() {
         s.push_str("<ul>\n");

@@ -52,7 +52,10 @@ pub fn render(report: &AuditReport) -> String {
         if m.verdict != Verdict::Ok {
             s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
         }
-        if let Some(after) = m.after.as_ref().filter(|_| m.replaced > 0) {
+        if let Some(why) = &m.no_fix {
+            s.push_str(&format!("{:<36}{}\n", "", terminal(why)));
+        }
+        if let Some(after) = m.after.as_ref().filter(|a| a.rewritten) {
             s.push_str(&format!(
                 "{:<36}after the fix: {} at {}\n",
                 "",
@@ -63,6 +66,14 @@ pub fn render(report: &AuditReport) -> String {
     }
     for f in &report.files {
         s.push_str(&file_lines(f));
+    }
+    for (rule, (why, files)) in file_findings(report) {
+        s.push_str(&format!(
+            "\n{} in {}: {}\n",
+            terminal(rule),
+            files_named(&files),
+            terminal(why)
+        ));
     }
     let failing: Vec<&str> = report.settings.fail_on.iter().map(|v| v.key()).collect();
     let unread = match report.counts.files_failed {
@@ -106,13 +117,6 @@ fn file_lines(f: &AuditedFile) -> String {
     if let Some(e) = &f.error {
         s.push_str(&format!("\nerror   {file}: {}\n", terminal(e)));
     }
-    for finding in &f.findings {
-        s.push_str(&format!(
-            "\n{file}: {} — {}\n",
-            terminal(&finding.rule),
-            terminal(&finding.why)
-        ));
-    }
     if let Some(fixed) = &f.fixed {
         s.push_str(&format!(
             "\nfixed   {file} → {} ({} replaced)\n",
@@ -127,6 +131,37 @@ fn file_lines(f: &AuditedFile) -> String {
         }
     }
     s
+}
+
+/// The files' own findings (a scene's Filter Glossy, say), one entry per rule with its
+/// reason and the files it fired in: most files share Blender's defaults, so a rule is one
+/// line, not one paragraph per file.
+pub(super) fn file_findings(
+    report: &AuditReport,
+) -> std::collections::BTreeMap<&str, (&str, Vec<&str>)> {
+    let mut rules = std::collections::BTreeMap::new();
+    for f in &report.files {
+        for finding in &f.findings {
+            let entry = rules
+                .entry(finding.rule.as_str())
+                .or_insert((finding.why.as_str(), Vec::new()));
+            if entry.1.last() != Some(&f.file.as_str()) {
+                entry.1.push(f.file.as_str());
+            }
+        }
+    }
+    rules
+}
+
+/// "a.blend", "a.blend and b.blend", or "12 files (a.blend, b.blend, …)".
+fn files_named(files: &[&str]) -> String {
+    let names: Vec<String> = files.iter().map(|f| terminal(short(f)).into_owned()).collect();
+    match names.as_slice() {
+        [one] => one.clone(),
+        [a, b] => format!("{a} and {b}"),
+        [a, b, ..] => format!("{} ({a}, {b}, …)", count(names.len(), "file", "files")),
+        [] => String::new(),
+    }
 }
 
 /// A file's name, for a table line.
