@@ -1,6 +1,7 @@
 //! A Blender chosen per job (issue 20, case 16): with Debian's Blender 3.4 first on PATH,
 //! `generate --extension` (which needs 4.2+) passes it over with a notice and uses the bpy
-//! 4.5 in the cache; with `--no-provision` and nothing newer, or a 3.4 the user named, it
+//! 4.5 in the cache, and so does `audit` of a file saved by 4.5 (issue 38), while a 3.4
+//! file is audited in 3.4 and a 3.4 the user named audits what it is given, saying so; with `--no-provision` and nothing newer, or a 3.4 the user named, it
 //! fails saying exactly that. No error names `--blender` unless the user passed it.
 //! Real Blenders only: the test suite's 3.4 and bpy 4.5, the latter linked into a temporary
 //! cache where gloffuse's own search finds it.
@@ -46,10 +47,19 @@ impl Setup {
     /// `gloffuse generate --extension OUT/x.zip ARGS` in this PATH and cache: exit code,
     /// stderr.
     fn extension(&self, args: &[&str], env_blender: Option<&Path>) -> (i32, String) {
+        let zip = self.out.join("x.zip");
+        let zip = zip.to_str().unwrap();
+        let args: Vec<&str> = ["generate", "--extension", zip]
+            .into_iter()
+            .chain(args.iter().copied())
+            .collect();
+        self.gloffuse(&args, env_blender)
+    }
+
+    /// `gloffuse ARGS` in this PATH and cache: exit code, stderr.
+    fn gloffuse(&self, args: &[&str], env_blender: Option<&Path>) -> (i32, String) {
         let mut cmd = gloffuse();
-        cmd.args(["generate", "--extension"])
-            .arg(self.out.join("x.zip"))
-            .args(args)
+        cmd.args(args)
             .env(
                 "PATH",
                 std::env::join_paths([&self.bin, Path::new("/usr/bin"), Path::new("/bin")])
@@ -135,4 +145,62 @@ fn an_old_blender_the_user_named_is_refused_by_the_name_they_used() {
     );
     assert!(!stderr.contains("--blender"), "{stderr}");
     assert!(!s.out.join("x.zip").exists());
+}
+
+/// The audit asks for a Blender as new as the newest file: a 4.5 file passes the 3.4 on
+/// PATH over for the cached bpy 4.5; a 3.4 file is audited by that 3.4; a 3.4 named with
+/// --blender audits the 4.5 file (it crashes on it) and the table says the file is newer.
+#[test]
+fn the_audit_uses_a_blender_as_new_as_the_file() {
+    let (Some(b34), Some(b45)) = (real_blender("3.4"), real_blender("4.5")) else {
+        return;
+    };
+    let s = setup(&b34).with_cached_bpy(&b45);
+    std::fs::create_dir_all(&s.out).unwrap();
+    let (old, new) = (s.out.join("old.blend"), s.out.join("new.blend"));
+    for (blender, file) in [(&b34, &old), (&b45, &new)] {
+        let script = format!(
+            "import bpy; bpy.ops.wm.read_factory_settings(use_empty=True); \
+             bpy.data.materials.new('m'); bpy.data.materials['m'].use_fake_user = True; \
+             bpy.ops.wm.save_as_mainfile(filepath={:?})",
+            file.to_str().unwrap()
+        );
+        let made = if blender == &b34 {
+            std::process::Command::new(blender)
+                .args(["-b", "--factory-startup", "--python-expr", &script])
+                .output()
+        } else {
+            std::process::Command::new(blender)
+                .args(["-c", &script])
+                .output()
+        };
+        assert!(file.exists(), "{made:?}");
+    }
+    let audit = |file: &Path, extra: &[&str]| {
+        let mut args = vec!["audit", "--no-render", file.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        s.gloffuse(&args, None)
+    };
+    let (_, stderr) = audit(&new, &[]);
+    assert!(
+        stderr.contains("not using `blender` on PATH")
+            && stderr.contains("is older than 4.5")
+            && stderr.contains("using Blender 4.5"),
+        "{stderr}"
+    );
+    let (_, stderr) = audit(&old, &[]);
+    assert!(stderr.contains("using Blender 3.4"), "{stderr}");
+    assert!(!stderr.contains("not using"), "{stderr}");
+    let named = b34.to_str().unwrap();
+    let mut cmd = gloffuse();
+    let out = cmd
+        .args(["audit", "--no-render", "--blender", named])
+        .arg(&new)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("saved by Blender 4.5, audited in 3.4.1"),
+        "{stdout}"
+    );
 }

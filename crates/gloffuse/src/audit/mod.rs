@@ -12,6 +12,7 @@ pub mod judge;
 pub mod merge;
 pub mod rules;
 pub mod verdict;
+pub mod which_blender;
 
 pub use verdict::{
     After, AuditJudging, AuditReport, AuditSettings, AuditedFile, AuditedMaterial, Counts, Finding,
@@ -98,7 +99,7 @@ pub fn audit(
 ) -> Result<AuditReport, Error> {
     // Bad input fails before Blender is looked for.
     let files = checked_files(o)?;
-    let blender = o.blender.find(progress)?;
+    let blender = which_blender::find_for_files(&o.blender, &files, progress)?;
     audit_files(&blender, o, &files, progress, on_file)
 }
 

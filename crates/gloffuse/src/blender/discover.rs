@@ -208,8 +208,8 @@ pub fn find_blender_in(
             Some(need) => {
                 let why = Hint::new(
                     format!(
-                        "Blender {} is older than {}.{}, which {{}} needs",
-                        found.version_string, need.version.major, need.version.minor
+                        "Blender {} is older than {}.{}, which {{}} needs ({})",
+                        found.version_string, need.version.major, need.version.minor, need.why
                     ),
                     [need.by],
                 );

@@ -11,6 +11,9 @@ pub const ENV_VAR: &str = "GLOFFUSE_BLENDER";
 
 /// The bpy series gloffuse provisions, and the pip requirement that selects it.
 pub const BPY_SERIES: &str = "4.5";
+/// [`BPY_SERIES`] as a version (a test keeps the two equal).
+pub const BPY_VERSION: crate::measure::BlenderVersion =
+    crate::measure::BlenderVersion { major: 4, minor: 5 };
 /// What installing it takes, for the notices (measured with bpy 4.5.x on CPython 3.11).
 pub const BPY_SIZE: &str = "a ~370 MB download, ~950 MB installed";
 pub const BPY_REQUIREMENT: &str = "bpy>=4.5,<4.6";

@@ -14,6 +14,7 @@ pub mod run;
 pub mod runs;
 
 pub use discover::{FindOptions, Need, find_blender};
+pub use environment::BPY_VERSION;
 pub use log_progress::{Estimate, Step, run_following_render, run_following_steps};
 pub use probe::{Blender, BlenderKind, probe};
 pub use process::Cancel;

@@ -2,7 +2,7 @@
 //! counts, then one card per material (failures first) with its picture (as authored |
 //! conserving twin | difference), its numbers and its findings with their fixes.
 
-use super::table::{counts, file_findings, order, pct};
+use super::table::{counts, file_findings, older_blender, order, pct};
 use crate::audit::{AuditReport, AuditedMaterial};
 use crate::plural::count;
 use crate::report::html::{banner, escape, page_css};
@@ -63,6 +63,17 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             "<div class=\"card error\"><b>{}</b>: {}</div>\n",
             escape(&f.file),
             escape(f.error.as_deref().unwrap_or_default())
+        ));
+    }
+    for (f, words) in report
+        .files
+        .iter()
+        .filter_map(|f| Some((f, older_blender(f, &report.blender_version)?)))
+    {
+        s.push_str(&format!(
+            "<div class=\"card\"><b>{}</b>: {}</div>\n",
+            escape(&f.file),
+            escape(&words)
         ));
     }
     for (rule, (why, files)) in file_findings(report) {

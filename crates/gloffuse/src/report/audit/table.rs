@@ -66,6 +66,13 @@ pub fn render(report: &AuditReport) -> String {
     }
     for f in &report.files {
         s.push_str(&file_lines(f));
+        if let Some(words) = older_blender(f, &report.blender_version) {
+            s.push_str(&format!(
+                "\nnote    {}: {}\n",
+                terminal(&f.file),
+                terminal(&words)
+            ));
+        }
     }
     for (rule, (why, files)) in file_findings(report) {
         s.push_str(&format!(
@@ -155,7 +162,10 @@ pub(super) fn file_findings(
 
 /// "a.blend", "a.blend and b.blend", or "12 files (a.blend, b.blend, …)".
 fn files_named(files: &[&str]) -> String {
-    let names: Vec<String> = files.iter().map(|f| terminal(short(f)).into_owned()).collect();
+    let names: Vec<String> = files
+        .iter()
+        .map(|f| terminal(short(f)).into_owned())
+        .collect();
     match names.as_slice() {
         [one] => one.clone(),
         [a, b] => format!("{a} and {b}"),
@@ -164,10 +174,93 @@ fn files_named(files: &[&str]) -> String {
     }
 }
 
+/// "saved by X, audited in Y" when the Blender that audited `f` is older (by major.minor)
+/// than the one that saved it: its rules and its renders then describe the file as that
+/// older Blender reads it (or explain why that Blender crashed on it).
+pub(super) fn older_blender(f: &AuditedFile, blender_version: &str) -> Option<String> {
+    fn major_minor(v: &str) -> Option<(u32, u32)> {
+        let mut parts = v.split(|c: char| !c.is_ascii_digit());
+        Some((parts.next()?.parse().ok()?, parts.next()?.parse().ok()?))
+    }
+    let saved = f.saved_by.as_deref()?;
+    if major_minor(saved)? <= major_minor(blender_version)? {
+        return None;
+    }
+    Some(format!(
+        "saved by Blender {saved}, audited in {blender_version}: an older Blender reads newer \
+         nodes and settings as it knows them (a 4.x Principled BSDF as 3.x's), so audit it in \
+         Blender {saved} or later"
+    ))
+}
+
 /// A file's name, for a table line.
 fn short(path: &str) -> &str {
     std::path::Path::new(path)
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(name: &str, saved_by: &str, findings: serde_json::Value) -> AuditedFile {
+        serde_json::from_value(serde_json::json!({
+            "file": name, "saved_by": saved_by, "error": null, "findings": findings,
+            "materials": 0, "log": null, "render_seconds": null, "scan_seconds": null,
+            "fixed": null
+        }))
+        .unwrap()
+    }
+
+    /// A file saved by a newer Blender than the one auditing says so; the same or an older
+    /// one does not (by major.minor: 3.4.1 audits 3.4 files).
+    #[test]
+    fn a_file_from_a_newer_blender_is_named() {
+        let f = file("a.blend", "4.5", serde_json::json!([]));
+        let words = older_blender(&f, "3.4.1").unwrap();
+        assert!(
+            words.starts_with("saved by Blender 4.5, audited in 3.4.1"),
+            "{words}"
+        );
+        assert!(older_blender(&f, "4.5.15 LTS").is_none());
+        assert!(older_blender(&f, "5.0.1").is_none());
+        assert!(older_blender(&file("b.blend", "3.4", serde_json::json!([])), "3.4.1").is_none());
+        assert!(older_blender(&file("c.blend", "4.10", serde_json::json!([])), "4.5").is_some());
+    }
+
+    /// A rule that fired in several files is one entry naming them all, in order.
+    #[test]
+    fn a_file_finding_is_one_entry_for_every_file() {
+        let finding = |rule: &str| {
+            serde_json::json!([{"rule": rule, "node": "scene ▸ Scene", "node_path": [],
+                "node_type": "Scene", "kind": "info", "versions": "", "why": "because",
+                "fix": "", "predicted": null, "twin": null, "detail": {}}])
+        };
+        let report: AuditReport = serde_json::from_value(serde_json::json!({
+            "gloffuse_version": "0", "blender_version": "4.5.15", "blender_program": "b",
+            "settings": {"cell": 64, "samples": 32, "seed": 0, "render": true,
+                "tolerance": 0.01, "ring_tolerance": 0.03, "fail_on": ["loses"]},
+            "passed": true, "counts": {"files": 3, "files_failed": 0, "materials": 0,
+                "ok": 0, "loses": 0, "creates": 0, "error": 0},
+            "files": [file("x/a.blend", "4.5", finding("filter-glossy")),
+                      file("x/b.blend", "4.5", serde_json::json!([])),
+                      file("y/c.blend", "4.5", finding("filter-glossy"))],
+            "materials": []
+        }))
+        .unwrap();
+        let rules = file_findings(&report);
+        assert_eq!(rules.len(), 1);
+        assert_eq!(
+            rules["filter-glossy"],
+            ("because", vec!["x/a.blend", "y/c.blend"])
+        );
+        let table = render(&report);
+        assert!(
+            table.contains("\nfilter-glossy in a.blend and c.blend: because\n"),
+            "{table}"
+        );
+        assert_eq!(table.matches("because").count(), 1, "{table}");
+    }
 }
