@@ -363,13 +363,15 @@ def compat_png_settings(settings):
     settings.color_mode = "RGBA"
 
 
-def compat_uv_sphere(bm, radius, segments, rings):
+def compat_uv_sphere(bm, radius, segments, rings, uvs=False):
     # bmesh's create_uvsphere takes `radius` since 3.0 (`diameter`, which was
     # really a radius, before).
     try:
-        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius,
+                                  calc_uvs=uvs)
     except TypeError:
-        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, diameter=radius)
+        bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, diameter=radius,
+                                  calc_uvs=uvs)
 
 
 def compat_disable_auto_smooth(mesh):
@@ -2812,18 +2814,21 @@ def library_contents():
 # A module of the gloffuse_blender package. Functions only; the version
 # differences of building a sphere go through compat.py.
 #
-#   sphere_mesh(name, radius, segments, rings, cut_below=None) -> mesh
+#   sphere_mesh(name, radius, segments, rings, cut_below=None, uv_map=None) -> mesh
 # ---------------------------------------------------------------------------
 
 
 
-def sphere_mesh(name, radius, segments, rings, cut_below=None):
+def sphere_mesh(name, radius, segments, rings, cut_below=None, uv_map=None):
     """A new smooth-shaded UV sphere mesh `name` around the origin, with one
     empty material slot; with `cut_below`, the vertices below that height are
-    dropped (and the faces they belong to)."""
+    dropped (and the faces they belong to); with `uv_map`, a UV map of that
+    name (the sphere's own unwrap)."""
     mesh = bpy.data.meshes.new(name)
     bm = bmesh.new()
-    compat_uv_sphere(bm, radius, segments, rings)
+    if uv_map is not None:
+        bm.loops.layers.uv.new(uv_map)  # create_uvsphere fills the active UV layer
+    compat_uv_sphere(bm, radius, segments, rings, uv_map is not None)
     if cut_below is not None:
         bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.z < cut_below], context="VERTS")
     bm.to_mesh(mesh)
