@@ -42,8 +42,10 @@ pub struct SphereStats {
     /// Σ alpha over the disc's area π R²: 1 for an opaque sphere, 0 for one the world is
     /// seen through everywhere (clamped to 1: the pixel filter spreads the edge).
     pub opacity: f64,
-    /// Σ RGB / (3 Σ alpha) over the pixels whose view cosine is below 0.3 (the outermost
-    /// ring of the disc and the edge the pixel filter spreads): the grazing-view brightness.
+    /// The grazing-view brightness: over the pixels whose view cosine is below 0.3 (the
+    /// outermost ring of the disc and the edge the pixel filter spreads), Σ RGB / Σ alpha
+    /// where the sphere covers the ring, the white world where it lets it through (as
+    /// [`SphereStats::seen`] weighs the mean).
     pub rim: f64,
     pub rings: Vec<Ring>,
 }
@@ -52,12 +54,32 @@ impl SphereStats {
     /// The mean as the furnace shows it: the sphere's own light over its opaque part, the
     /// white world (1.0) over the rest of its disc. An opaque sphere's `mean`.
     pub fn seen(&self) -> f64 {
-        self.opacity * self.mean + (1.0 - self.opacity)
+        if self.opacity > 0.0 {
+            self.opacity * self.mean + (1.0 - self.opacity)
+        } else {
+            1.0
+        }
     }
 }
 
 /// The view cosine below which a pixel counts to the rim: √(1 − 0.954²) = 0.3.
 const RIM_MU: f64 = 0.3;
+
+/// The rim as the furnace shows it, from its sums: `rgb` and `alpha` over the pixels whose
+/// centre lies beyond the rim's inner circle, `inner` the pixels within it, on a disc of
+/// `radius` pixels. An opaque disc's alpha sums to its area π R² (the pixel filter moves
+/// alpha but keeps its sum), all of it in the `inner` pixels and the rim's: so the rim's
+/// opacity is Σ alpha / (π R² − inner), exact on the pixel lattice.
+fn seen_rim(rgb: f64, alpha: f64, radius: f64, inner: usize) -> f64 {
+    let area = std::f64::consts::PI * radius * radius - inner as f64;
+    let opacity = if area > 0.0 {
+        (alpha / area).min(1.0)
+    } else {
+        1.0
+    };
+    let own = if alpha > 0.0 { rgb / alpha } else { 0.0 };
+    opacity * own + (1.0 - opacity)
+}
 
 /// Statistics of cell `index` in a grid of `columns` cells of `cell` pixels, where the
 /// sphere's diameter is `radius_fraction` of the cell.
@@ -80,7 +102,7 @@ pub fn sphere_stats(
     let mut ring_channel = [[0.0f64; 3]; RINGS];
     let mut ring_sq = [0.0f64; RINGS];
     let mut ring_n = [0usize; RINGS];
-    let (mut rim_rgb, mut rim_a) = (0.0f64, 0.0f64);
+    let (mut rim_rgb, mut rim_a, mut inner) = (0.0f64, 0.0f64, 0usize);
     let rim_d = (1.0 - RIM_MU * RIM_MU).sqrt();
     for y in y0..(y0 + cell).min(img.height) {
         for x in x0..(x0 + cell).min(img.width) {
@@ -97,6 +119,8 @@ pub fn sphere_stats(
             if d >= rim_d {
                 rim_rgb += rgb;
                 rim_a += p[3] as f64;
+            } else {
+                inner += 1;
             }
             // Only pixels whose filter footprint lies inside the disc count as fully
             // covered; what alpha leaves is the white world seen through the sphere.
@@ -166,11 +190,7 @@ pub fn sphere_stats(
         },
         coverage: sum_a / (cell * cell) as f64,
         opacity: (sum_a / (std::f64::consts::PI * radius * radius)).min(1.0),
-        rim: if rim_a > 0.0 {
-            rim_rgb / rim_a
-        } else {
-            f64::NAN
-        },
+        rim: seen_rim(rim_rgb, rim_a, radius, inner),
         rings,
     }
 }
