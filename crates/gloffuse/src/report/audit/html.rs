@@ -58,6 +58,18 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
          twin, red: brighter; ±5 % at full colour).</p>\n<p>Rerun: <code>{}</code></p>\n",
         escape(rerun)
     ));
+    s.push_str(&file_cards(report));
+    for (index, m) in order(report) {
+        s.push_str(&card(m, pictures.get(index).cloned().flatten()));
+    }
+    s.push_str("</main></body></html>\n");
+    s
+}
+
+/// The files' own cards: errors, a file newer than the Blender that audited it, and the
+/// file findings (one per rule, naming the files).
+fn file_cards(report: &AuditReport) -> String {
+    let mut s = String::new();
     for f in report.files.iter().filter(|f| f.error.is_some()) {
         s.push_str(&format!(
             "<div class=\"card error\"><b>{}</b>: {}</div>\n",
@@ -86,10 +98,6 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             names.join(", ")
         ));
     }
-    for (index, m) in order(report) {
-        s.push_str(&card(m, pictures.get(index).cloned().flatten()));
-    }
-    s.push_str("</main></body></html>\n");
     s
 }
 
