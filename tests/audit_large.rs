@@ -106,12 +106,12 @@ fn thousands_of_materials_are_judged_and_a_grid_too_large_is_an_error() {
 
     let (code, report, stderr) = audit(
         &blender,
-        &[file.as_os_str(), "--resolution".as_ref(), "2048".as_ref()],
+        &[file.as_os_str(), "--resolution".as_ref(), "1024".as_ref()],
     );
     assert_eq!(code, 1, "{stderr}");
     let error = report["files"][0]["error"].as_str().unwrap_or_default();
     assert!(
-        error.contains("65536 px a side") && error.contains("2800 spheres"),
+        error.contains("2800 spheres of 1024 px") && error.contains("at most 256 spheres fit"),
         "{error}\n{stderr}"
     );
 }

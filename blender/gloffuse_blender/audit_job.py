@@ -337,11 +337,10 @@ def audit_main(document_text):
     fixed = None
     if args.save:
         fixed = fix_and_save(entries, document, args, groups, audit["fix"])
-        if audit["render"]:
-            # What is judged now is the copy as saved.
-            path = open_user_file(args.save)
-            file_findings = scan_scenes(rules)
-            entries = scan_file(rules, groups)
+        # What is judged now is the copy as saved.
+        path = open_user_file(args.save)
+        file_findings = scan_scenes(rules)
+        entries = scan_file(rules, groups)
 
     rendered = None
     if audit["render"]:

@@ -66,6 +66,11 @@ FURNACE_CAMERA_HEIGHT = 10.0
 # a larger grid would lose its last rows and columns.
 FURNACE_MAX_RESOLUTION = 65536
 
+# The most pixels one furnace render may hold: 2^28 (4 GiB of float RGBA in
+# Blender's render result, as much again in its passes). 2800 spheres of 1024 px
+# fit Blender's side limit but would need 47 GB.
+FURNACE_MAX_PIXELS = 1 << 28
+
 # A solid furnace's sphere k sits FURNACE_SOLID_SPACING (k mod
 # FURNACE_SOLID_LEVELS) cells behind its grid cell: seen from one sphere
 # (radius <= half a cell) the spheres of other depths cover at most
@@ -214,6 +219,13 @@ def furnace_layout(cells, cell):
                          "most %d px a side: at most %d spheres fit at this cell size (a smaller "
                          "cell fits more)" % (cells, cell, columns * cell, rows * cell,
                                               FURNACE_MAX_RESOLUTION, side * side))
+    if columns * rows * cell * cell > FURNACE_MAX_PIXELS:
+        raise ValueError("%d spheres of %d px need a %d x %d px render, and the audit renders "
+                         "at most %d pixels at once (%.0f GB of pixels would not fit in "
+                         "memory): at most %d spheres fit at this cell size (a smaller cell "
+                         "fits more)" % (cells, cell, columns * cell, rows * cell,
+                                         FURNACE_MAX_PIXELS, columns * rows * cell * cell * 16e-9,
+                                         FURNACE_MAX_PIXELS // (cell * cell)))
     return columns, rows
 
 
