@@ -32,7 +32,7 @@ GLOSSY_TYPES = ("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
 MULTISCATTER_TWIN = "Multiscatter GGX"
 CLAMP_TWIN = "clamped to 1"
 TOON_TWIN = "Smooth 0"
-ADD_TWIN = "scaled to 100 %"
+ADD_TWIN = "itself (a fix scales the Add Shader to 100 % by its brightness)"
 
 # Nodes that carry no reflecting closure (add-reflecting), and the colour
 # inputs that may exceed 1 (light, not albedo: color-above-one).
