@@ -467,3 +467,35 @@ fn bad_input_is_refused_and_fail_on_chooses_the_failing_verdicts() {
     );
     assert_eq!(code, 0, "{report}");
 }
+
+/// A text file named .blend is that file's error, said in words (no Python traceback from
+/// Blender), and the other files are audited all the same.
+#[test]
+fn a_text_file_named_blend_is_its_own_error_in_words() {
+    let Some(blender) = common::blender::real_blender("3.4") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    make_library(&blender, dir.path(), None);
+    let text = dir.path().join("notes.blend");
+    std::fs::write(&text, "hello, not a blend\n").unwrap();
+    let (code, report, stderr) = audit(
+        &blender,
+        &[
+            text.as_os_str(),
+            dir.path().join("rules.blend").as_os_str(),
+            "--no-render".as_ref(),
+        ],
+    );
+    assert_eq!(code, 1, "{stderr}");
+    let files = report["files"].as_array().unwrap();
+    let error = files[0]["error"].as_str().unwrap_or_default();
+    assert!(
+        error.contains("notes.blend")
+            && error.contains("does not start with a .blend header")
+            && !error.contains("Traceback"),
+        "{error}"
+    );
+    assert!(files[1]["error"].is_null(), "{}", files[1]);
+    assert!(report["materials"].as_array().unwrap().len() > 5);
+}

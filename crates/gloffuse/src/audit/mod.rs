@@ -576,6 +576,15 @@ fn audit_file(
         path: file.to_path_buf(),
         source,
     })?;
+    // A file that is no .blend (a text file so named) is said so here, not by a Python
+    // traceback from Blender.
+    if let Err(why) = read_header(&real) {
+        return Err(Error::input(
+            Field::AuditPath,
+            file.display(),
+            Hint::text(format!("a .blend file (this file {why})")),
+        ));
+    }
     // The file itself is replaced: its writers' lock is held from before Blender reads it
     // until it is replaced.
     let wait = Wait {
