@@ -499,3 +499,61 @@ fn a_text_file_named_blend_is_its_own_error_in_words() {
     assert!(files[1]["error"].is_null(), "{}", files[1]);
     assert!(report["materials"].as_array().unwrap().len() > 5);
 }
+
+/// A material nothing uses (as a script or an importer writes them) survives a fix: Blender
+/// writes nothing without users, so the fixed copy would lose it.
+#[test]
+fn a_material_nothing_uses_survives_a_fix() {
+    let Some(blender) = common::blender::real_blender("3.4") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("orphans.blend");
+    let script = format!(
+        "import bpy\n\
+         bpy.ops.wm.read_factory_settings(use_empty=True)\n\
+         for name, distribution in (('orphan-ggx', 'GGX'), ('orphan-multi', 'MULTI_GGX')):\n\
+         \x20   m = bpy.data.materials.new(name)\n\
+         \x20   m.use_nodes = True\n\
+         \x20   g = m.node_tree.nodes.new('ShaderNodeBsdfGlossy')\n\
+         \x20   g.distribution = distribution\n\
+         \x20   g.inputs['Roughness'].default_value = 1.0\n\
+         \x20   m.node_tree.links.new(g.outputs[0], m.node_tree.nodes['Material Output'].inputs[0])\n\
+         bpy.data.libraries.write({:?}, set(bpy.data.materials), fake_user=False)\n",
+        file.to_str().unwrap()
+    );
+    let made = std::process::Command::new(&blender)
+        .args(["-b", "--factory-startup", "--python-expr", &script])
+        .output()
+        .unwrap();
+    assert!(file.exists(), "{made:?}");
+    let fixed = dir.path().join("fixed.blend");
+    let (_, report, stderr) = audit(
+        &blender,
+        &[
+            file.as_os_str(),
+            "--fix".as_ref(),
+            fixed.as_os_str(),
+            "--no-render".as_ref(),
+        ],
+    );
+    let names = |r: &Value| -> BTreeSet<String> {
+        r["materials"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["material"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let before = names(&report);
+    assert_eq!(before.len(), 2, "{stderr}");
+    let ggx = material(&report, "orphans.blend", "orphan-ggx");
+    assert_eq!(ggx["after"]["rewritten"], true, "{ggx}");
+    assert_eq!(ggx["after"]["verdict"], "ok", "{ggx}");
+    let (_, again, stderr) = audit(&blender, &[fixed.as_os_str(), "--no-render".as_ref()]);
+    assert_eq!(
+        names(&again),
+        before,
+        "the fixed copy keeps every material\n{stderr}"
+    );
+}

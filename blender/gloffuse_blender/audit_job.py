@@ -166,8 +166,17 @@ def fix_and_save(entries, document, args, groups, fix):
     if built is not None:
         remove_unused_added(built[0])
         restore_groups(built[1])
+    keep_unused_materials()
     path = save_blend(args.save, args.compress)
     return {"path": shown_path(path), "replaced": replaced, "materials": materials}
+
+
+def keep_unused_materials():
+    """Blender writes nothing that has no users, so a material no object uses would
+    be missing from the fixed copy: a fake user keeps it (as the file had it)."""
+    for material in bpy.data.materials:
+        if material.library is None and material.users == 0:
+            material.use_fake_user = True
 
 
 # --- the furnace -------------------------------------------------------------------
