@@ -557,3 +557,61 @@ fn a_material_nothing_uses_survives_a_fix() {
         "the fixed copy keeps every material\n{stderr}"
     );
 }
+
+/// A group linked from a library, with a group nested in it (linked from there too), is one
+/// `linked-library` finding on the material, not one per group; the lobe inside it has no
+/// fix here, and the report says which file to fix.
+#[test]
+fn a_linked_library_is_named_once_per_material() {
+    let Some(blender) = common::blender::real_blender("3.4") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (library, file) = (dir.path().join("lib.blend"), dir.path().join("user.blend"));
+    let script = format!(
+        "import bpy\n\
+         bpy.ops.wm.read_factory_settings(use_empty=True)\n\
+         inner = bpy.data.node_groups.new('Inner', 'ShaderNodeTree')\n\
+         inner.outputs.new('NodeSocketShader', 'Shader')\n\
+         out = inner.nodes.new('NodeGroupOutput')\n\
+         glossy = inner.nodes.new('ShaderNodeBsdfGlossy')\n\
+         inner.links.new(glossy.outputs[0], out.inputs[0])\n\
+         outer = bpy.data.node_groups.new('Outer', 'ShaderNodeTree')\n\
+         outer.outputs.new('NodeSocketShader', 'Shader')\n\
+         out = outer.nodes.new('NodeGroupOutput')\n\
+         node = outer.nodes.new('ShaderNodeGroup')\n\
+         node.node_tree = inner\n\
+         outer.links.new(node.outputs[0], out.inputs[0])\n\
+         outer.use_fake_user = True\n\
+         bpy.ops.wm.save_as_mainfile(filepath={lib:?})\n\
+         bpy.ops.wm.read_factory_settings(use_empty=True)\n\
+         with bpy.data.libraries.load({lib:?}, link=True) as (src, dst):\n\
+         \x20   dst.node_groups = ['Outer']\n\
+         m = bpy.data.materials.new('uses-linked')\n\
+         m.use_nodes = True\n\
+         m.use_fake_user = True\n\
+         g = m.node_tree.nodes.new('ShaderNodeGroup')\n\
+         g.node_tree = bpy.data.node_groups['Outer']\n\
+         m.node_tree.links.new(g.outputs[0], m.node_tree.nodes['Material Output'].inputs[0])\n\
+         bpy.ops.wm.save_as_mainfile(filepath={file:?})\n",
+        lib = library.to_str().unwrap(),
+        file = file.to_str().unwrap()
+    );
+    let made = std::process::Command::new(&blender)
+        .args(["-b", "--factory-startup", "--python-expr", &script])
+        .output()
+        .unwrap();
+    assert!(file.exists(), "{made:?}");
+    let (_, report, stderr) = audit(&blender, &[file.as_os_str(), "--no-render".as_ref()]);
+    let m = material(&report, "user.blend", "uses-linked");
+    let linked = m["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["rule"] == "linked-library")
+        .count();
+    assert_eq!(linked, 1, "{m}\n{stderr}");
+    // Its losing lobe is the library's to fix, and the report says so.
+    let why = m["no_fix"].as_str().unwrap_or_default();
+    assert!(why.contains("linked from //lib.blend"), "{m}");
+}

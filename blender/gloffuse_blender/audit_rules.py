@@ -551,8 +551,23 @@ def scan_material(material, rules, groups):
     if is_missing(material) and not any(item["rule"] == "linked-library" for item in found):
         found.append(finding("linked-library", None, {"library": None, "missing": True}))
         found[-1]["node"] = [material.name]
+    found = once_per_library(found)
     error = material_errors(found)
     return [item for item in found if item["rule"] in rules], error
+
+
+def once_per_library(found):
+    """The findings with one linked-library finding per library: the groups nested in
+    a linked group come from its library too, and would repeat it."""
+    seen = set()
+    kept = []
+    for item in found:
+        if item["rule"] == "linked-library":
+            if item["detail"]["library"] in seen:
+                continue
+            seen.add(item["detail"]["library"])
+        kept.append(item)
+    return kept
 
 
 def scan_scenes(rules):

@@ -31,6 +31,9 @@ pub fn choose(
     if !matches!(verdict, Verdict::Loses | Verdict::Creates) {
         return Ok(None);
     }
+    if let Some(why) = in_a_library(findings) {
+        return Err(why);
+    }
     let Some((own, twin)) = measured else {
         // The rules alone (no furnace render): their replacements, unmeasured.
         return match replaced {
@@ -63,6 +66,28 @@ pub fn choose(
         ));
     }
     Ok(Some(MaterialFix { scale: None }))
+}
+
+/// Why a failing lobe cannot be fixed here: it lies inside what a `linked-library`
+/// finding names (the material itself, or a group on its path), which only its library
+/// file can change.
+fn in_a_library(findings: &[Finding]) -> Option<String> {
+    let failing = findings
+        .iter()
+        .filter(|f| matches!(f.kind, Effect::Loses | Effect::Creates));
+    for f in failing {
+        let linked = findings
+            .iter()
+            .find(|l| l.rule == "linked-library" && f.node_path.starts_with(&l.node_path));
+        if let Some(l) = linked {
+            let library = l.detail["library"].as_str().unwrap_or("its library");
+            return Some(format!(
+                "no safe fix for {} at {}: it is linked from {library}, so fix that file",
+                f.rule, f.node
+            ));
+        }
+    }
+    None
 }
 
 /// Why the material has no safe twin, naming the finding that needs one: its twin creates
@@ -171,6 +196,30 @@ mod tests {
         )];
         let why = choose(Verdict::Creates, &nested, 0, Some((b(1.09), b(1.09))), &j).unwrap_err();
         assert!(why.contains("not the material's whole surface"), "{why}");
+    }
+
+    #[test]
+    fn a_lobe_inside_a_linked_group_is_its_library_to_fix() {
+        let j = AuditJudging::default();
+        let mut lobe = finding(
+            "glossy-single-scatter",
+            Effect::Loses,
+            serde_json::json!({}),
+        );
+        lobe.node_path = vec!["M".into(), "Group".into(), "Glossy".into()];
+        let mut linked = finding(
+            "linked-library",
+            Effect::Info,
+            serde_json::json!({"library": "//lib.blend"}),
+        );
+        linked.node_path = vec!["M".into(), "Group".into()];
+        let found = [linked.clone(), lobe.clone()];
+        let why = choose(Verdict::Loses, &found, 1, Some((b(0.8), b(1.0))), &j).unwrap_err();
+        assert!(why.contains("linked from //lib.blend"), "{why}");
+        // A linked group beside the lobe, not above it, leaves it to fix.
+        linked.node_path = vec!["M".into(), "Other".into()];
+        let found = [linked, lobe];
+        assert!(choose(Verdict::Loses, &found, 1, Some((b(0.8), b(1.0))), &j).is_ok());
     }
 
     #[test]
