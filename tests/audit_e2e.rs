@@ -615,3 +615,50 @@ fn a_linked_library_is_named_once_per_material() {
     let why = m["no_fix"].as_str().unwrap_or_default();
     assert!(why.contains("linked from //lib.blend"), "{m}");
 }
+
+/// A material whose surface is an add-on's node, opened without that add-on (so Blender
+/// reads it as an undefined node that renders black), is an `error` that says so.
+#[test]
+fn an_add_on_node_without_its_add_on_is_an_error() {
+    let Some(blender) = common::blender::real_blender("3.4") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("addon.blend");
+    // The add-on registers a node built on a group; the audit's Blender has no such add-on.
+    let script = format!(
+        "import bpy\n\
+         bpy.ops.wm.read_factory_settings(use_empty=True)\n\
+         class AddonShader(bpy.types.ShaderNodeCustomGroup):\n\
+         \x20   bl_idname = 'AddonShader'\n\
+         \x20   bl_label = 'Add-on Shader'\n\
+         \x20   def init(self, context):\n\
+         \x20       tree = bpy.data.node_groups.new('.addon', 'ShaderNodeTree')\n\
+         \x20       tree.outputs.new('NodeSocketShader', 'BSDF')\n\
+         \x20       glossy = tree.nodes.new('ShaderNodeBsdfGlossy')\n\
+         \x20       tree.links.new(glossy.outputs[0], tree.nodes.new('NodeGroupOutput').inputs[0])\n\
+         \x20       self.node_tree = tree\n\
+         bpy.utils.register_class(AddonShader)\n\
+         m = bpy.data.materials.new('addon-material')\n\
+         m.use_nodes = True\n\
+         m.use_fake_user = True\n\
+         n = m.node_tree.nodes.new('AddonShader')\n\
+         m.node_tree.links.new(n.outputs[0], m.node_tree.nodes['Material Output'].inputs[0])\n\
+         bpy.ops.wm.save_as_mainfile(filepath={:?})\n",
+        file.to_str().unwrap()
+    );
+    let made = std::process::Command::new(&blender)
+        .args(["-b", "--factory-startup", "--python-expr", &script])
+        .output()
+        .unwrap();
+    assert!(file.exists(), "{made:?}");
+    let (code, report, stderr) = audit(&blender, &[file.as_os_str()]);
+    assert_eq!(code, 1, "{stderr}");
+    let m = material(&report, "addon.blend", "addon-material");
+    assert_eq!(m["verdict"], "error", "{m}");
+    let reason = m["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("renders black") && reason.contains("add-on"),
+        "{reason}"
+    );
+}
