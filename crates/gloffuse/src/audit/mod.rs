@@ -572,19 +572,7 @@ fn audit_file(
     predictor: &mut Predictor,
     progress: &dyn Progress,
 ) -> Result<FileAudit, Error> {
-    let real = std::fs::canonicalize(file).map_err(|source| Error::Read {
-        path: file.to_path_buf(),
-        source,
-    })?;
-    // A file that is no .blend (a text file so named) is said so here, not by a Python
-    // traceback from Blender.
-    if let Err(why) = read_header(&real) {
-        return Err(Error::input(
-            Field::AuditPath,
-            file.display(),
-            Hint::text(format!("a .blend file (this file {why})")),
-        ));
-    }
+    let real = blend_to_open(file)?;
     // The file itself is replaced: its writers' lock is held from before Blender reads it
     // until it is replaced.
     let wait = Wait {
@@ -646,6 +634,23 @@ fn audit_file(
         }
     }
     Ok((file_entry, materials, image, installed))
+}
+
+/// The file Blender opens for `file` (every link followed). A file that is no .blend (a
+/// text file so named) is said so here, not by a Python traceback from Blender.
+fn blend_to_open(file: &Path) -> Result<PathBuf, Error> {
+    let real = std::fs::canonicalize(file).map_err(|source| Error::Read {
+        path: file.to_path_buf(),
+        source,
+    })?;
+    match read_header(&real) {
+        Ok(_) => Ok(real),
+        Err(why) => Err(Error::input(
+            Field::AuditPath,
+            file.display(),
+            Hint::text(format!("a .blend file (this file {why})")),
+        )),
+    }
 }
 
 /// The fixes the judged materials call for, in the job's material order.
