@@ -251,18 +251,13 @@ fn by_furnace(
     if own.mean < BLACK
         && let Some(f) = findings.iter().find(|f| f.rule == "unknown-node")
     {
-        let why = if f.node_type == "ShaderNodeScript" {
-            "an OSL script needs Cycles' Open Shading Language, which a headless Blender \
-             cannot compile"
-        } else {
-            "a node this Blender does not know: an add-on's node needs its add-on, a newer \
-             Blender's node that Blender"
-        };
         return (
             Verdict::Error,
             format!(
-                "renders black: {} at {} did not render in this Blender ({why})",
-                f.rule, f.node
+                "renders black: {} at {} did not render in this Blender ({})",
+                f.rule,
+                f.node,
+                why_unknown(f)
             ),
         );
     }
@@ -299,6 +294,17 @@ fn by_furnace(
             pct(twin.mean)
         ),
     )
+}
+
+/// Why a node the audit does not know may render black.
+fn why_unknown(f: &Finding) -> &'static str {
+    if f.node_type == "ShaderNodeScript" {
+        "an OSL script needs Cycles' Open Shading Language, which a headless Blender cannot \
+         compile"
+    } else {
+        "a node this Blender does not know: an add-on's node needs its add-on, a newer \
+         Blender's node that Blender"
+    }
 }
 
 #[cfg(test)]
