@@ -500,6 +500,15 @@ fn a_text_file_named_blend_is_its_own_error_in_words() {
     assert!(report["materials"].as_array().unwrap().len() > 5);
 }
 
+/// Runs a Python `script` in the Blender 3.4 executable `blender`, which must write `file`.
+fn make_in_blender_34(blender: &Path, script: &str, file: &Path) {
+    let made = std::process::Command::new(blender)
+        .args(["-b", "--factory-startup", "--python-expr", script])
+        .output()
+        .unwrap();
+    assert!(file.exists(), "{made:?}");
+}
+
 /// A material nothing uses (as a script or an importer writes them) survives a fix: Blender
 /// writes nothing without users, so the fixed copy would lose it.
 #[test]
@@ -522,11 +531,7 @@ fn a_material_nothing_uses_survives_a_fix() {
          bpy.data.libraries.write({:?}, set(bpy.data.materials), fake_user=False)\n",
         file.to_str().unwrap()
     );
-    let made = std::process::Command::new(&blender)
-        .args(["-b", "--factory-startup", "--python-expr", &script])
-        .output()
-        .unwrap();
-    assert!(file.exists(), "{made:?}");
+    make_in_blender_34(&blender, &script, &file);
     let fixed = dir.path().join("fixed.blend");
     let (_, report, stderr) = audit(
         &blender,
@@ -597,11 +602,7 @@ fn a_linked_library_is_named_once_per_material() {
         lib = library.to_str().unwrap(),
         file = file.to_str().unwrap()
     );
-    let made = std::process::Command::new(&blender)
-        .args(["-b", "--factory-startup", "--python-expr", &script])
-        .output()
-        .unwrap();
-    assert!(file.exists(), "{made:?}");
+    make_in_blender_34(&blender, &script, &file);
     let (_, report, stderr) = audit(&blender, &[file.as_os_str(), "--no-render".as_ref()]);
     let m = material(&report, "user.blend", "uses-linked");
     let linked = m["findings"]
@@ -647,11 +648,7 @@ fn an_add_on_node_without_its_add_on_is_an_error() {
          bpy.ops.wm.save_as_mainfile(filepath={:?})\n",
         file.to_str().unwrap()
     );
-    let made = std::process::Command::new(&blender)
-        .args(["-b", "--factory-startup", "--python-expr", &script])
-        .output()
-        .unwrap();
-    assert!(file.exists(), "{made:?}");
+    make_in_blender_34(&blender, &script, &file);
     let (code, report, stderr) = audit(&blender, &[file.as_os_str()]);
     assert_eq!(code, 1, "{stderr}");
     let m = material(&report, "addon.blend", "addon-material");
