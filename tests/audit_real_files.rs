@@ -10,7 +10,7 @@
 //! (or, where the probe leaves it open, the second furnace's); the rules the probe needs are
 //! reported; a material invisible everywhere is not judged; and after `--fix` the second
 //! furnace, run on the fixed copy, finds every fixed material at 100 % and every untouched
-//! one unchanged.
+//! one unchanged, and a probe that has a conserving twin in every Blender is fixed.
 
 mod common;
 
@@ -159,6 +159,13 @@ fn check_material(label: &str, m: &Value, want: &Value, second: f64, second_afte
         );
     }
     let position = want["position"] == true;
+    if want["fixed"] == true {
+        assert_eq!(
+            m["after"]["rewritten"], true,
+            "{what}: a conserving twin exists, yet the fix left it alone ({})",
+            m["no_fix"]
+        );
+    }
     check_fix(&what, m, verdict, position, (second, second_after));
 }
 

@@ -119,8 +119,8 @@ def group_needs(entries, groups):
     """The (mode, distribution) of every gloffuse group a twin uses, sorted."""
     by_name = {name: (mode, distribution) for mode, names in groups.items()
                for distribution, name in names.items()}
-    return sorted({by_name[item["twin"]] for entry in entries for item in entry["findings"]
-                   if item["twin"] in by_name})
+    return sorted({by_name[name] for entry in entries for item in entry["findings"]
+                   for name in (item["twin"], item.get("metal_twin")) if name in by_name})
 
 
 def provided_groups(document):

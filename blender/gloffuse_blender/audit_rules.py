@@ -256,7 +256,12 @@ def rule_principled_creates_energy(node, groups):
     if node.bl_idname != "ShaderNodeBsdfPrincipled":
         return []
     twin = groups["layered"].get("GGX") if principled_without_transmission(node) else None
-    return [finding("principled-creates-energy", node, principled_detail(node), twin)]
+    item = finding("principled-creates-energy", node, principled_detail(node), twin)
+    if twin is not None and constant(node.inputs["Metallic"]) != 0.0:
+        # The metal part: gloffuse's Multiscatter group, not Blender's Multiscatter
+        # GGX, which before 4.0 renders too bright mixed with another closure.
+        item["metal_twin"] = groups["multiscatter"].get("GGX")
+    return [item]
 
 
 def layering_parts(mix):

@@ -90,8 +90,9 @@ def glossy_twin(tree, node, item):
 
 def principled_layered_twin(tree, node, item):
     """The Layered group for a Principled BSDF before 4.0; where it is partly
-    metallic, a Mix Shader by its Metallic of that group and a Multiscatter GGX
-    Glossy of its Base Color (both conserve in 3.x, as its own lobes do not)."""
+    metallic, a Mix Shader by its Metallic of that group and gloffuse's
+    Multiscatter group of its Base Color (both conserve in 3.x, as its own lobes
+    do not, and as Multiscatter GGX does not in a mix there)."""
     ior = item["detail"].get("ior")
     inputs = {"Base Color": node.inputs["Base Color"], "Roughness": node.inputs["Roughness"],
               "Normal": node.inputs["Normal"]}
@@ -99,25 +100,33 @@ def principled_layered_twin(tree, node, item):
     metallic = node.inputs["Metallic"]
     if constant(metallic) == 0.0:
         return group_in_place(tree, node, item["twin"], inputs, values)
-    group = bpy.data.node_groups.get(item["twin"])
-    if group is None:
+    layered_group = bpy.data.node_groups.get(item["twin"])
+    metal_group = bpy.data.node_groups.get(item.get("metal_twin") or "")
+    if layered_group is None or metal_group is None:
         return False
-    layered = tree.nodes.new("ShaderNodeGroup")
-    layered.node_tree = group
+    layered = group_node(tree, layered_group, (node.location.x - 200, node.location.y))
     layered.inputs["IOR"].default_value = values["IOR"]
-    metal = tree.nodes.new("ShaderNodeBsdfGlossy")
-    metal.distribution = "MULTI_GGX"
+    metal = group_node(tree, metal_group, (node.location.x - 200, node.location.y - 200))
     for name, socket in inputs.items():
         feed(tree, layered.inputs[name], socket)
         feed(tree, metal.inputs["Color" if name == "Base Color" else name], socket)
     mix = tree.nodes.new("ShaderNodeMixShader")
     feed(tree, mix.inputs[0], metallic)
-    tree.links.new(next(s for s in layered.outputs if s.type == "SHADER"), mix.inputs[1])
-    tree.links.new(metal.outputs["BSDF"], mix.inputs[2])
-    layered.location = node.location.x - 200, node.location.y
-    metal.location = node.location.x - 200, node.location.y - 200
+    tree.links.new(shader_output(layered), mix.inputs[1])
+    tree.links.new(shader_output(metal), mix.inputs[2])
     replace_node(tree, node, mix)
     return True
+
+
+def group_node(tree, group, location):
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.location = location
+    return node
+
+
+def shader_output(node):
+    return next(s for s in node.outputs if s.type == "SHADER")
 
 
 def mix_layered_twin(tree, node, item):
