@@ -659,3 +659,71 @@ fn an_add_on_node_without_its_add_on_is_an_error() {
         "{reason}"
     );
 }
+
+/// A file Blender opens with an error report and loads all the same (a sequencer strip on a
+/// channel no Blender reads, `tests/blender/unreadable_strip.py`) is audited in the Blender
+/// `label`: its material judged, the report a `load-warning` file finding in Blender's
+/// words; fixed into a copy, never in place, where saving would drop the strip.
+fn a_file_loaded_with_an_error(label: &str) {
+    let (Some(maker), Some(blender)) = (
+        common::blender::real_blender("3.4"),
+        common::blender::real_blender(label),
+    ) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("strip.blend");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/unreadable_strip.py");
+    let made = common::blender::run_in_blender(&maker, &script, &["--".as_ref(), file.as_os_str()]);
+    assert!(made.status.success() && file.exists(), "{made:?}");
+    let before = std::fs::read(&file).unwrap();
+
+    let (code, report, stderr) = audit(&blender, &[file.as_os_str(), "--in-place".as_ref()]);
+    assert_eq!(code, 1, "Blender {label}: {stderr}");
+    let audited = &report["files"][0];
+    assert!(audited["error"].is_null(), "Blender {label}: {audited}");
+    let warning = audited["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["rule"] == "load-warning")
+        .unwrap_or_else(|| panic!("Blender {label}: no load-warning in {audited}"));
+    let why = warning["why"].as_str().unwrap();
+    assert!(why.contains("channel larger than 128"), "{why}");
+    let m = material(&report, "strip.blend", "rough-ggx");
+    assert_eq!(m["verdict"], "loses", "Blender {label}: {m}");
+    assert!(
+        m["no_fix"].as_str().unwrap().contains("not fixed in place"),
+        "Blender {label}: {m}"
+    );
+    assert_eq!(std::fs::read(&file).unwrap(), before, "Blender {label}");
+    assert!(!file.with_extension("blend1").exists());
+
+    let fixed = dir.path().join("fixed.blend");
+    let (_, report, stderr) = audit(
+        &blender,
+        &["--fix".as_ref(), fixed.as_os_str(), file.as_os_str()],
+    );
+    let m = material(&report, "strip.blend", "rough-ggx");
+    assert_eq!(
+        m["after"]["rewritten"], true,
+        "Blender {label}: {m}\n{stderr}"
+    );
+    assert_eq!(m["after"]["verdict"], "ok", "Blender {label}: {m}");
+    assert_eq!(std::fs::read(&file).unwrap(), before, "Blender {label}");
+}
+
+#[test]
+fn a_file_loaded_with_an_error_is_audited_in_blender_3_4() {
+    a_file_loaded_with_an_error("3.4");
+}
+
+#[test]
+fn a_file_loaded_with_an_error_is_audited_in_blender_4_5() {
+    a_file_loaded_with_an_error("4.5");
+}
+
+#[test]
+fn a_file_loaded_with_an_error_is_audited_in_blender_5_0() {
+    a_file_loaded_with_an_error("5.0");
+}

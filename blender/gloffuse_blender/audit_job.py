@@ -296,12 +296,30 @@ def furnace_render(entries, audit):
 # --- main ----------------------------------------------------------------------------
 
 def open_user_file(path):
-    """Open the user's file (never saved: the audit only reads it)."""
+    """Open the user's file (never saved: the audit only reads it). Returns its
+    path and what Blender reported as an error while it still loaded the file
+    (a strip it could not read, say), or None: such a file is audited, and the
+    report becomes a file finding."""
     path = os.path.abspath(path)
     if not os.path.isfile(path):
         raise FileNotFoundError("no .blend file at %s" % path)
-    bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
-    return path
+    try:
+        bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+    except RuntimeError as error:
+        # bpy raises on any error report, also when the read went on and the file
+        # is open; a file that did not load is still this error.
+        if not bpy.data.filepath or not os.path.samefile(bpy.data.filepath, path):
+            raise
+        return path, str(error).strip()
+    return path, None
+
+
+def load_findings(rules, said):
+    """The file finding of what Blender reported while loading the file."""
+    if said is None or "load-warning" not in rules:
+        return []
+    return [{"rule": "load-warning", "node": ["file"], "node_type": "File",
+             "detail": {"blender_said": said}, "twin": None}]
 
 
 def parse_audit_args(argv=None):
@@ -326,10 +344,10 @@ def audit_main(document_text):
     args = parse_audit_args()
     rules = applicable_rules(audit["rules"])
     groups = twin_groups(audit)
-    path = open_user_file(args.open)
+    path, said = open_user_file(args.open)
 
     start = time.perf_counter()
-    file_findings = scan_scenes(rules)
+    file_findings = load_findings(rules, said) + scan_scenes(rules)
     entries = scan_file(rules, groups)
     scan_seconds = time.perf_counter() - start
 
@@ -347,8 +365,8 @@ def audit_main(document_text):
     if args.save:
         fixed = fix_and_save(entries, document, args, groups, audit["fix"])
         # What is judged now is the copy as saved.
-        path = open_user_file(args.save)
-        file_findings = scan_scenes(rules)
+        path, said = open_user_file(args.save)
+        file_findings = load_findings(rules, said) + scan_scenes(rules)
         entries = scan_file(rules, groups)
 
     rendered = None

@@ -95,6 +95,9 @@ pub fn word(f: &JobFinding, predictor: &mut Predictor) -> Finding {
         || "a rule this gloffuse does not know".to_string(),
         |r| r.why.to_string(),
     );
+    if let Some(said) = f.detail["blender_said"].as_str() {
+        why = format!("{why} (Blender said “{said}”)");
+    }
     if let Some(p) = predicted {
         why.push_str(&format!(
             "; the integrator predicts {:.1} % for this lobe",

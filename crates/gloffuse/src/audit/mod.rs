@@ -610,6 +610,9 @@ fn audit_file(
     let image = read_grids(&job)?;
     judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
     let (mut file_entry, mut materials) = judged(file, &job, image.as_ref(), o, predictor);
+    if matches!(target, Some(Installing::InPlace(_))) {
+        keep_a_partly_read_file(&file_entry, &mut materials);
+    }
     let mut installed = None;
     if let (Some(target), Some(temp), Some(plan)) = (target, temp, fix) {
         let chosen = chosen_fixes(&materials);
@@ -634,6 +637,22 @@ fn audit_file(
         }
     }
     Ok((file_entry, materials, image, installed))
+}
+
+/// A file Blender loaded only in part (a `load-warning`) is never saved over: what Blender
+/// could not read would be gone from it. Its fixes become reasons.
+fn keep_a_partly_read_file(file: &AuditedFile, materials: &mut [AuditedMaterial]) {
+    if !file.findings.iter().any(|f| f.rule == "load-warning") {
+        return;
+    }
+    for m in materials.iter_mut().filter(|m| m.fix.is_some()) {
+        m.fix = None;
+        m.no_fix = Some(
+            "not fixed in place: Blender could not read all of this file (load-warning), so \
+             saving over it would drop what it could not read; fix it into a copy instead"
+                .to_string(),
+        );
+    }
 }
 
 /// The file Blender opens for `file` (every link followed). A file that is no .blend (a

@@ -172,6 +172,15 @@ pub const RULES: &[Rule] = &[
         fix: "set Render ▸ Light Paths ▸ Caustics ▸ Filter Glossy to 0 for final renders",
     },
     Rule {
+        id: "load-warning",
+        effect: Effect::Info,
+        from: v(3, 0),
+        before: None,
+        why: "Blender reported an error opening the file and loaded the rest: what it could not \
+              read is not audited, a fixed copy lacks it, and the file is not fixed in place",
+        fix: "open the file in the Blender that saved it and resolve what the message names",
+    },
+    Rule {
         id: "missing-texture",
         effect: Effect::Error,
         from: v(3, 0),

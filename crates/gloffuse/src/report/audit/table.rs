@@ -140,24 +140,25 @@ fn file_lines(f: &AuditedFile) -> String {
     s
 }
 
-/// The files' own findings (a scene's Filter Glossy, say), one entry per rule with its
-/// reason and the files it fired in: most files share Blender's defaults, so a rule is one
-/// line, not one paragraph per file.
-pub(super) fn file_findings(
-    report: &AuditReport,
-) -> std::collections::BTreeMap<&str, (&str, Vec<&str>)> {
+/// The files' own findings (a scene's Filter Glossy, say), one entry per rule and reason
+/// with the files it fired in: most files share Blender's defaults, so a rule is one line,
+/// not one paragraph per file (a reason that quotes the file's own message is its own).
+pub(super) fn file_findings(report: &AuditReport) -> Vec<(&str, (&str, Vec<&str>))> {
     let mut rules = std::collections::BTreeMap::new();
     for f in &report.files {
         for finding in &f.findings {
-            let entry = rules
-                .entry(finding.rule.as_str())
-                .or_insert((finding.why.as_str(), Vec::new()));
-            if entry.1.last() != Some(&f.file.as_str()) {
-                entry.1.push(f.file.as_str());
+            let files: &mut Vec<&str> = rules
+                .entry((finding.rule.as_str(), finding.why.as_str()))
+                .or_default();
+            if files.last() != Some(&f.file.as_str()) {
+                files.push(f.file.as_str());
             }
         }
     }
     rules
+        .into_iter()
+        .map(|((rule, why), files)| (rule, (why, files)))
+        .collect()
 }
 
 /// "a.blend", "a.blend and b.blend", or "12 files (a.blend, b.blend, …)".
@@ -253,8 +254,8 @@ mod tests {
         let rules = file_findings(&report);
         assert_eq!(rules.len(), 1);
         assert_eq!(
-            rules["filter-glossy"],
-            ("because", vec!["x/a.blend", "y/c.blend"])
+            rules[0],
+            ("filter-glossy", ("because", vec!["x/a.blend", "y/c.blend"]))
         );
         let table = render(&report);
         assert!(
