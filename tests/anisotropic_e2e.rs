@@ -304,7 +304,7 @@ fn the_anisotropic_group_renders_every_ring_at_100_percent() {
 /// A library of the anisotropic groups alone, made by Blender 3.4, passes
 /// `tests/blender/check_assets.py`: every group has a rendered preview (the shading-normal
 /// group is built with the Beckmann spec, which has no anisotropic group in 3.4, and takes
-/// the GGX one's), catalogs, licence, nothing else.
+/// the GGX one's), catalogs, licence, nothing else; the summary says which Blenders it suits.
 #[test]
 fn an_anisotropic_library_passes_the_asset_checks() {
     let Some(blender) = real_blender("3.4") else {
@@ -334,6 +334,12 @@ fn an_anisotropic_library_passes_the_asset_checks() {
     assert!(
         groups.contains(&GROUP) && !groups.contains(&BECKMANN_GROUP),
         "{groups:?}"
+    );
+    // Built in 3.4 with 3.4's preset, it suits 3.4 and says 3.5 on is another masking.
+    let suits = summary["suits"].as_str().unwrap_or_default();
+    assert!(
+        suits.starts_with("Blender 3.4 (") && suits.contains("from 3.5 on"),
+        "{suits}"
     );
     let checker = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/check_assets.py");
     let result = dir.path().join("assets.json");

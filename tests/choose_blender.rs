@@ -150,6 +150,7 @@ fn an_old_blender_the_user_named_is_refused_by_the_name_they_used() {
 /// The audit asks for a Blender as new as the newest file: a 4.5 file passes the 3.4 on
 /// PATH over for the cached bpy 4.5; a 3.4 file is audited by that 3.4; a 3.4 named with
 /// --blender audits the 4.5 file (it crashes on it) and the table says the file is newer.
+/// `generate --into` chooses the same way, and a refusal names gloffuse's own bpy.
 #[test]
 fn the_audit_uses_a_blender_as_new_as_the_file() {
     let (Some(b34), Some(b45)) = (real_blender("3.4"), real_blender("4.5")) else {
@@ -202,5 +203,53 @@ fn the_audit_uses_a_blender_as_new_as_the_file() {
     assert!(
         stdout.contains("saved by Blender 4.5, audited in 3.4.1"),
         "{stdout}"
+    );
+    // 3.4 crashes on 4.5's meshes (the default cube): the error says so in a sentence, not
+    // as Blender's log.
+    let cube = s.out.join("cube.blend");
+    let script = format!(
+        "import bpy; bpy.ops.wm.read_factory_settings(); \
+         bpy.ops.wm.save_as_mainfile(filepath={:?})",
+        cube.to_str().unwrap()
+    );
+    let made = std::process::Command::new(&b45)
+        .args(["-c", &script])
+        .output();
+    assert!(cube.exists(), "{made:?}");
+    let out = gloffuse()
+        .args(["audit", "--no-render", "--blender", named])
+        .arg(&cube)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(
+            "Blender 3.4 could not audit this file, saved by the newer Blender 4.5: audit it in \
+             Blender 4.5 or later (Blender was killed by signal 11); log: "
+        ) && !stdout.contains("the log ends"),
+        "{stdout}"
+    );
+
+    // `generate --into` saves the file: the 4.5 file is updated by the cached bpy 4.5, not
+    // by the 3.4 on PATH; with 3.4 named, the refusal names gloffuse's own bpy 4.5.
+    let into = |extra: &[&str]| {
+        let mut args = vec!["generate", "--coefficients", "seed", "--into"];
+        args.push(new.to_str().unwrap());
+        args.extend_from_slice(extra);
+        s.gloffuse(&args, None)
+    };
+    let (code, stderr) = into(&[]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("not using `blender` on PATH") && stderr.contains("using Blender 4.5"),
+        "{stderr}"
+    );
+    let (code, stderr) = into(&["--blender", named]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("saved by Blender 4.5")
+            && stderr.contains("gloffuse's own bpy 4.5 reads it")
+            && stderr.contains("--no-provision"),
+        "{stderr}"
     );
 }

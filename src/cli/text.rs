@@ -37,6 +37,9 @@ pub fn generated(out: &Generated) -> String {
         let _ = writeln!(s, "extension: {}", p.display());
     }
     let _ = writeln!(s, "coefficients: {}", out.coefficients);
+    if let Some(suits) = &out.suits {
+        let _ = writeln!(s, "suits: {suits}");
+    }
     let _ = writeln!(s, "groups: {}", out.groups.join(", "));
     for r in &out.renamed {
         let _ = writeln!(

@@ -193,15 +193,7 @@ impl UserBlend {
             return Err(Error::input(
                 field,
                 path.display(),
-                Hint::new(
-                    format!(
-                        "a file saved by Blender {blender} or older: this one was saved by \
-                         Blender {saved_by}, and saving it from {blender} would lose what \
-                         {blender} does not know (run a Blender {saved_by} or newer with {{}}, \
-                         or accept the loss with {{}})",
-                    ),
-                    [Field::Blender, Field::AllowDowngrade],
-                ),
+                downgrade_hint(saved_by, blender),
             ));
         }
         let real = std::fs::canonicalize(path).map_err(|e| Error::Read {
@@ -348,6 +340,39 @@ fn changed_since(meta: &std::fs::Metadata, when: SystemTime) -> bool {
 }
 
 /// Whether a file saved by `saved_by` is newer (by major.minor) than `blender`.
+/// What a file newer than the Blender that would save it needs: a Blender as new, which
+/// gloffuse has itself for a file up to its own bpy's series (found unless a Blender is
+/// named or installing is off), or accepting the loss.
+fn downgrade_hint(saved_by: BlenderVersion, blender: BlenderVersion) -> Hint {
+    let lost = format!(
+        "a file saved by Blender {blender} or older: this one was saved by Blender \
+         {saved_by}, and saving it from {blender} would lose what {blender} does not know"
+    );
+    if newer(saved_by, crate::blender::BPY_VERSION) {
+        return Hint::new(
+            format!(
+                "{lost} (run a Blender {saved_by} or newer with {{}}, or accept the loss with \
+                 {{}})"
+            ),
+            [Field::Blender, Field::AllowDowngrade],
+        );
+    }
+    Hint::new(
+        format!(
+            "{lost} (gloffuse's own bpy {} reads it: leave out {{}} and {{}} to have it found \
+             or installed; or run a Blender {saved_by} or newer with {{}}, or accept the loss \
+             with {{}})",
+            crate::blender::BPY_VERSION
+        ),
+        [
+            Field::Blender,
+            Field::NoProvision,
+            Field::Blender,
+            Field::AllowDowngrade,
+        ],
+    )
+}
+
 fn newer(saved_by: BlenderVersion, blender: BlenderVersion) -> bool {
     (saved_by.major, saved_by.minor) > (blender.major, blender.minor)
 }

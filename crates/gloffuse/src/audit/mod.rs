@@ -12,7 +12,6 @@ pub mod judge;
 pub mod merge;
 pub mod rules;
 pub mod verdict;
-pub mod which_blender;
 
 pub use verdict::{
     After, AuditJudging, AuditReport, AuditSettings, AuditedFile, AuditedMaterial, Counts, Finding,
@@ -23,11 +22,11 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use crate::blend_file::{MATERIAL, count_blocks};
-use crate::blender::{Blender, BlenderOptions};
+use crate::blender::{Blender, BlenderOptions, find_for_files};
 use crate::file_lock::Wait;
 use crate::fit::Coefficients;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{Distribution, Engine};
+use crate::measure::{BlenderVersion, Distribution, Engine};
 use crate::output::{check_destination, temp_beside};
 use crate::plural::count;
 use crate::progress::Progress;
@@ -99,7 +98,7 @@ pub fn audit(
 ) -> Result<AuditReport, Error> {
     // Bad input fails before Blender is looked for.
     let files = checked_files(o)?;
-    let blender = which_blender::find_for_files(&o.blender, &files, progress)?;
+    let blender = find_for_files(&o.blender, &files, Field::AuditPath, None, progress)?;
     audit_files(&blender, o, &files, progress, on_file)
 }
 
@@ -236,7 +235,12 @@ fn audit_one(
         fix.and_then(|fix| audit_file(settings, twins, file, fix.as_ref(), o, predictor, progress));
     match audited {
         Err(e @ Error::Interrupted { .. }) => Err(e),
-        Err(e) => Ok((failed_file(file, &e), Vec::new(), None, None)),
+        Err(e) => Ok((
+            failed_file(file, &e, settings.blender.version),
+            Vec::new(),
+            None,
+            None,
+        )),
         Ok(ok) => Ok(ok),
     }
 }
@@ -840,14 +844,19 @@ fn attach_after(materials: &mut [AuditedMaterial], after: Vec<AuditedMaterial>) 
     }
 }
 
-fn failed_file(file: &Path, e: &Error) -> AuditedFile {
+/// A file that could not be audited, with why. Where a Blender older than the file failed
+/// on it (3.4 crashes on 4.x meshes, and reads no 5.x file at all), that is the reason,
+/// with the last words Blender said and its log, not its whole output.
+fn failed_file(file: &Path, e: &Error, blender: BlenderVersion) -> AuditedFile {
+    let saved_by = read_header(file).ok().and_then(|h| h.version);
+    let error = match saved_by {
+        Some(saved) if saved > blender => too_new(e, saved, blender),
+        _ => e.to_string(),
+    };
     AuditedFile {
         file: file.display().to_string(),
-        saved_by: read_header(file)
-            .ok()
-            .and_then(|h| h.version)
-            .map(|v| v.to_string()),
-        error: Some(e.to_string()),
+        saved_by: saved_by.map(|v| v.to_string()),
+        error: Some(error),
         findings: Vec::new(),
         materials: 0,
         log: None,
@@ -856,4 +865,29 @@ fn failed_file(file: &Path, e: &Error) -> AuditedFile {
         grid: None,
         fixed: None,
     }
+}
+
+/// Why a Blender older than a file failed on it, in a sentence: what to run instead, then
+/// Blender's last error line (or how it ended: a crash has none) and its log's path.
+fn too_new(e: &Error, saved: BlenderVersion, blender: BlenderVersion) -> String {
+    let text = e.to_string();
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let log = lines.iter().position(|l| l.starts_with("log:"));
+    let ended = lines
+        .first()
+        .map_or("", |l| l.split(';').next().unwrap_or(l));
+    let said = lines[..log.unwrap_or(lines.len())]
+        .iter()
+        .rev()
+        .find(|l| l.contains("Error"))
+        .copied()
+        .unwrap_or(ended);
+    let mut words = format!(
+        "Blender {blender} could not audit this file, saved by the newer Blender {saved}: \
+         audit it in Blender {saved} or later ({said})"
+    );
+    if let Some(log) = log.map(|i| lines[i]) {
+        words.push_str(&format!("; {log}"));
+    }
+    words
 }

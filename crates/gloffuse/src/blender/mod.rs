@@ -6,6 +6,7 @@
 
 pub mod discover;
 pub mod environment;
+pub mod for_files;
 pub mod log_progress;
 pub mod probe;
 pub mod process;
@@ -15,6 +16,7 @@ pub mod runs;
 
 pub use discover::{FindOptions, Need, find_blender};
 pub use environment::BPY_VERSION;
+pub use for_files::find_for_files;
 pub use log_progress::{Estimate, Step, run_following_render, run_following_steps};
 pub use probe::{Blender, BlenderKind, probe};
 pub use process::Cancel;

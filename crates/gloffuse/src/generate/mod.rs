@@ -9,6 +9,7 @@ pub mod catalogs;
 pub mod extension;
 pub mod params;
 pub mod script;
+pub mod suits;
 
 pub use params::{
     ColorModel, Curves, GenerateParams, GroupSpec, Mode, correction_group_name, layered_group_name,
@@ -20,7 +21,9 @@ use serde::Serialize;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
-use crate::blender::{Blender, BlenderOptions, Run, RunOutput, command_line, run_following_steps};
+use crate::blender::{
+    Blender, BlenderOptions, Run, RunOutput, command_line, find_for_files, run_following_steps,
+};
 use crate::error::{Error, Field, Hint};
 use crate::file_lock::{FileLock, Wait};
 use crate::fit::{Coefficients, preset_for};
@@ -85,6 +88,9 @@ pub struct Generated {
     /// The catalog definition file written (merged) beside a new .blend.
     pub catalogs: Option<PathBuf>,
     pub extension: Option<PathBuf>,
+    /// The Blenders the groups built suit (by the Blender that saved them and the masking
+    /// their Cycles corrections fit), when a Blender ran.
+    pub suits: Option<String>,
     /// The groups built, as the job reports them when a Blender ran; else every group the
     /// script builds (in Blender 3.0–3.4 it leaves out anisotropic Beckmann).
     pub groups: Vec<String>,
@@ -231,6 +237,8 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         backup: None,
         catalogs: None,
         extension: None,
+        suits: (blender.as_ref())
+            .map(|b| suits::library(pinned.as_ref().map(|p| p.1), &engines, b.version)),
         groups: params.group_names(),
         renamed: Vec::new(),
         log: None,
@@ -317,7 +325,8 @@ fn pinned_coefficients(g: &GenerateOptions) -> Result<Option<(Coefficients, &str
 }
 
 /// The Blender to run when a .blend or an extension is asked for (a script needs none);
-/// it must be able to build an extension if one is asked for.
+/// it must be able to build an extension if one is asked for, and should be as new as the
+/// file to update (else saving it would lose what that Blender does not know).
 fn blender_for(g: &GenerateOptions, progress: &dyn Progress) -> Result<Option<Blender>, Error> {
     let needs_blender = g.blend.is_some() || g.into.is_some() || g.extension.is_some();
     if !needs_blender {
@@ -325,7 +334,14 @@ fn blender_for(g: &GenerateOptions, progress: &dyn Progress) -> Result<Option<Bl
     }
     // An extension needs 4.2+: an older Blender on PATH is passed over, not refused.
     let need = g.extension.is_some().then_some(extension::NEED);
-    Ok(Some(g.blender.find_for(need, progress)?))
+    let into: Vec<PathBuf> = g.into.iter().cloned().collect();
+    Ok(Some(find_for_files(
+        &g.blender,
+        &into,
+        Field::Into,
+        need,
+        progress,
+    )?))
 }
 
 /// The script's parameters: the pinned coefficients' curves or every engine's presets;
