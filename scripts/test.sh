@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
-# The whole test suite, against real Blender: installs what is missing, then runs cargo test.
+# The whole test suite, against real Blender: installs what is missing, checks the format
+# and clippy, then runs cargo test. With --fast: the fast tier alone (the files whose doc
+# says `Tier: fast`: unit, CLI, physics and lint tests, no Blender), which installs only
+# ruff; it names the Blender-tier files it leaves out.
 #   Blender 3.4 — Debian's `blender` package (a real binary); a `blender` on PATH that is
 #     not 3.4 is not used
 #   Blender 4.5 LTS and 5.0 — PyPI's `bpy` (Blender as a Python module, CPython 3.11 only);
@@ -155,8 +158,42 @@ provision_tool() { # name, program in its venv's bin, pip requirement
 # munge's socket path is limited.
 slurm_state() { echo "$cache/slurm"; }
 
+# rustfmt and clippy, warnings as errors.
+lint() {
+    say "cargo fmt --check; cargo clippy"
+    cargo fmt --all --check
+    cargo clippy --locked --workspace --all-targets --quiet -- -D warnings
+}
+
+# The integration test files of a tier ("fast" or "blender"), one name per line.
+tier_files() {
+    local f
+    for f in tests/*.rs; do
+        if grep -q "^//! Tier: $1" "$f"; then basename "$f" .rs; fi
+    done
+}
+
+fast() {
+    mkdir -p "$cache"
+    find_python
+    provision_tool ruff ruff 'ruff>=0.17,<0.18'
+    export GLOFFUSE_TEST_RUFF="$cache/ruff/bin/ruff"
+    lint
+    local targets=() name
+    while read -r name; do targets+=(--test "$name"); done < <(tier_files fast)
+    cargo test --locked --workspace --lib --bins "${targets[@]}" "$@"
+    say "not run (the Blender tier; \`bash scripts/test.sh\` runs everything):" \
+        $(tier_files blender)
+}
+
 main() {
     cd "$(dirname "${BASH_SOURCE[0]}")/.."
+    if [ "${1:-}" = "--fast" ]; then
+        shift
+        fast "$@"
+        return
+    fi
+    lint
     mkdir -p "$cache"
     debian_packages
     find_blender_34

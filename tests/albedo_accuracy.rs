@@ -1,5 +1,7 @@
 //! The integrator against independent oracles: closed forms, a brute-force f64 midpoint
 //! rule with far more points, published Blender measurements, and physical bounds.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 mod common;
 

@@ -2,6 +2,8 @@
 //! the half vector that evaluates D and G2 (the integrator never evaluates D), the isotropic
 //! integrator where the two widths agree, the swap symmetry of X and Y (and the grid built with
 //! it, against the integrator point by point), and the closed form of GGX at α = 1.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 mod common;
 

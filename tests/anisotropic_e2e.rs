@@ -5,6 +5,8 @@
 //! builds it when no tangent is linked). On a convex sphere in the furnace a pixel is that
 //! albedo exactly, so the rings must agree within the render's noise, and must not agree
 //! with the isotropic albedo (which is what the test would see if anisotropy were ignored).
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

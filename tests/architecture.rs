@@ -1,6 +1,8 @@
 //! The structure docs/ARCHITECTURE.md describes, checked: which crate may depend on what,
 //! which stage may import which, that the library never names a command-line flag, and
 //! that a long function says why it is long.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use std::collections::BTreeSet;
 use std::fs;
@@ -308,4 +310,68 @@ fn the_long_function_check_can_fail() {
     )
     .unwrap();
     assert!(unexplained_long_functions(&long, 80).is_empty());
+}
+
+/// What only a Blender-tier test may call: the real Blenders, the libraries and files made
+/// in them, and the browser.
+const NEEDS_INSTALLS: [&str; 9] = [
+    "real_blender(",
+    "real_blenders(",
+    "render_cases(",
+    "run_in_blender(",
+    "make_library(",
+    "view_library(",
+    "user_file::",
+    "browser()",
+    "GLOFFUSE_TEST_BPY",
+];
+
+/// The tier a test file names in its doc comment (`//! Tier: fast …` or `//! Tier:
+/// blender …`), if it names one.
+fn tier_of(text: &str) -> Option<&str> {
+    text.lines()
+        .take_while(|l| l.starts_with("//!"))
+        .find_map(|l| l.strip_prefix("//! Tier: "))
+        .and_then(|rest| rest.split([' ', '.']).next())
+}
+
+/// Every integration test file names its tier, and a fast one calls nothing that needs what
+/// `scripts/test.sh` installs (`--fast` runs the fast files alone, by that line).
+#[test]
+fn every_test_file_names_its_tier_and_a_fast_one_needs_no_blender() {
+    let mut wrong = Vec::new();
+    let mut fast = 0;
+    for file in fs::read_dir(root().join("tests")).unwrap() {
+        let path = file.unwrap().path();
+        if path.extension().is_none_or(|e| e != "rs") {
+            continue;
+        }
+        let text = fs::read_to_string(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        match tier_of(&text) {
+            Some("blender") => {}
+            // This file lists the calls it looks for.
+            Some("fast") if name == "architecture.rs" => fast += 1,
+            Some("fast") => {
+                fast += 1;
+                let code: String = text.lines().map(code_of).collect::<Vec<_>>().join("\n");
+                for call in NEEDS_INSTALLS.iter().filter(|c| code.contains(**c)) {
+                    wrong.push(format!("{name} is fast but calls {call}"));
+                }
+            }
+            other => wrong.push(format!("{name} names no tier ({other:?})")),
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
+    assert!(fast > 10, "only {fast} fast test files");
+}
+
+#[test]
+fn the_tier_check_can_fail() {
+    assert_eq!(
+        tier_of("//! A test.\n//!\n//! Tier: fast (no Blender).\n"),
+        Some("fast")
+    );
+    assert_eq!(tier_of("//! Tier: blender.\n"), Some("blender"));
+    assert_eq!(tier_of("//! A test.\nfn x() {}\n//! Tier: fast\n"), None);
 }

@@ -4,6 +4,8 @@
 //! 3.4, 4.5 and 5.0: every material gets the expected verdict and findings, the furnace
 //! agrees with the integrator and with the twins, the reports hold every material, the
 //! user's files stay byte for byte; then the fixes and bad input.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -1,6 +1,8 @@
 //! `gloffuse audit` on what a large or awkward library meets, in real Blenders: compressed
 //! files of thousands of materials (made by `tests/blender/many_materials.py`, counted by
 //! Blender itself), a grid too large for one render, and a fixed copy saved to a full disk.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -11,6 +11,8 @@
 //! reported; a material invisible everywhere is not judged; and after `--fix` the second
 //! furnace, run on the fixed copy, finds every fixed material at 100 % and every untouched
 //! one unchanged, and a probe that has a conserving twin in every Blender is fixed.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -18,6 +18,8 @@
 //!   --no-provision`, and a row fails if the error is about that Blender instead of the
 //!   input (only the one row whose input is fine expects it), and no Blender run directory
 //!   appears in the cache (`XDG_CACHE_HOME` points at a temporary directory).
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 mod common;
 

@@ -11,6 +11,8 @@
 //! a temporary directory here) and the command to rerun it; no panic; and no output: neither
 //! `OUT.blend`, nor the `.gloffuse-*.blend` it is saved as first, nor `--script`'s file, nor
 //! `--report`'s directory.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 mod common;
 

@@ -4,6 +4,8 @@
 //!
 //! Real Blenders are found as `tests/common/blender.rs` says: a missing one fails the test
 //! unless `GLOFFUSE_SKIP_BLENDER_TESTS=1` asks to skip it.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -1,6 +1,8 @@
 //! The classic BRDFs (`gloffuse::measure::brdf`) against independent oracles: reciprocity, the
 //! horizon, the sampler against its own pdf, brute-force quadrature over the sphere with far
 //! more points than the sampler uses, and closed-form albedos derived in the comments.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use glam::DVec3;
 use gloffuse::measure::brdf::{

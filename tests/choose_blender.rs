@@ -5,6 +5,8 @@
 //! fails saying exactly that. No error names `--blender` unless the user passed it.
 //! Real Blenders only: the test suite's 3.4 and bpy 4.5, the latter linked into a temporary
 //! cache where gloffuse's own search finds it.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

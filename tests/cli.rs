@@ -1,5 +1,7 @@
 //! The `gloffuse` binary driven as a user would, including bad input: every bad input must
 //! exit 2 with a message naming the input, never panic, and never leave a file behind.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 mod common;
 

@@ -2,6 +2,8 @@
 //! back from the EXR with the exr crate and checked texel by texel against independent
 //! oracles: the brute-force Fresnel-weighted albedo (`common::oracle`) for R, the plain
 //! albedo for G, and the closed-form limits (no coat at IOR 1).
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 mod common;
 

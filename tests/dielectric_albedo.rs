@@ -2,6 +2,8 @@
 //! midpoint rule over the outgoing direction that evaluates each lobe's BSDF (D, G2, the
 //! refraction Jacobian; the integrator never evaluates D), and the limits: a smooth
 //! interface and a matched index return everything.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use glam::DVec3;
 use gloffuse::measure::fresnel;

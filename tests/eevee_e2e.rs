@@ -6,6 +6,8 @@
 //! view and multiscatter groups bring every ring to the lighting; the Cycles groups in EEVEE
 //! render what their descriptions quote; and `refresh --engine eevee` measures curves that
 //! agree with the `eevee` preset.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

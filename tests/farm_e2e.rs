@@ -3,6 +3,8 @@
 //! as a Slurm array job on the one-node cluster `scripts/test.sh` starts
 //! (`scripts/slurm/local-cluster.sh`) and as an Open Job Description template under PyPI's
 //! `openjd run`. Blender 3.4 (Debian's), whose start is the quickest.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

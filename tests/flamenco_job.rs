@@ -2,6 +2,8 @@
 //! graph its `compileJob` builds, against a recording stand-in for Flamenco's `author`), and
 //! the commands it builds, given to the real `gloffuse`, which must accept every flag (no
 //! Flamenco farm runs here: docs/GUIDE.md says so).
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

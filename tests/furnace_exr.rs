@@ -4,6 +4,8 @@
 //!
 //! Fixtures are written at run time with the `exr` crate into a temporary directory whose
 //! name holds spaces and non-ASCII characters, then damaged byte by byte where needed.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use std::path::{Path, PathBuf};
 

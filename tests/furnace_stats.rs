@@ -7,6 +7,8 @@
 //! ring [lo, hi) of view cosines holds πR²(hi² − lo²) pixels with mean
 //! (2/3)(hi³ − lo³)/(hi² − lo²); independent pixel noise of standard deviation σ gives a
 //! standard error σ/√N over the N fully covered pixels.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use std::f64::consts::PI;
 

@@ -2,6 +2,8 @@
 //! holds the public groups with their exact sockets, defaults and asset marks, and Cycles
 //! itself, evaluating the groups, gives gains equal to 100/f(r) from the coefficients
 //! (computed here in Rust: an independent evaluation of the same curve).
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

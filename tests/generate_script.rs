@@ -1,5 +1,7 @@
 //! Generated Python without Blender: byte-stable, parses, and no parameter text can become
 //! code (checked by CPython's own parser on arbitrary Unicode, see check_script.py).
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use gloffuse::fit::Coefficients;
 use gloffuse::generate::{ColorModel, Curves, GenerateParams, Job, Mode, assemble};

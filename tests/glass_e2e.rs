@@ -6,6 +6,8 @@
 //! within the render's noise, in each Blender's own form of the BSDF (3.4: two closures
 //! weighted by the Fresnel at the normal; 4.5 and 5.0: one closure with a per-microfacet
 //! Fresnel), and must not agree with the other version's form where they differ.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -17,6 +17,8 @@
 //! command lines are run too, and must end with 0. So are the `gloffuse` lines of the
 //! README's ```sh blocks (its first uses), after the guide's, unless the guide ran the same
 //! command already.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

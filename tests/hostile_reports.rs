@@ -4,6 +4,8 @@
 //! tampered shard by name (exit 2, never a panic, an abort or a hang), and must print and
 //! write names that cannot drive a terminal or break the JUnit XML; `farm` must write jobs
 //! whose folder and program reach the farm exactly.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -4,6 +4,8 @@
 //! to them renders what the integrator predicts for it (a check of the Fresnel-weighted
 //! physics by Blender's own nodes); and over a grey base the GGX group agrees with
 //! Principled BSDF, Blender 4.x's own layering, ring by ring.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

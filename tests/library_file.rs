@@ -4,6 +4,8 @@
 //! cannot be written; catalogs added during the run are kept; catalog files Blender would
 //! ignore are refused. The files are inspected by `tests/blender/user_file.py`, in Blender,
 //! independently of gloffuse's package.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -1,6 +1,8 @@
 //! The lookup tables: every container read back by an independent reader (exr, ddsfile,
 //! ktx2), split-sum values against oracles that share no code with the fast kernels,
 //! Kulla–Conty against the albedo integrator and an energy balance, and bad input.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use gloffuse::lut::split_sum::{
     Estimate, Rule, Sampler, split_sum, split_sum_texel_quadrature, split_sum_texel_sampled,

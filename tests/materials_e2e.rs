@@ -24,6 +24,8 @@
 //! Layered (GGX)` against Principled BSDF, and `Gloffuse View (GGX)` against Multiscatter
 //! GGX, where the lobe's shape shows and not only its total; and a solid `Gloffuse Glass
 //! (GGX)` sphere in it against Multiscatter GGX glass.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -7,6 +7,8 @@
 //! does there was read in Cycles' source, not run (`docs/BLENDER-VERSIONS.md`). These tests
 //! run the real Blenders: the compat functions are the oracle's subject, each version's
 //! known behaviour (from its release notes and the Cycles source) the oracle.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -2,6 +2,8 @@
 //! symbolic link is written through to its target and stays a link; a FIFO, a character
 //! device or `/dev/stdout` is streamed to; `-` is standard output (and the summary moves to
 //! stderr); a regular file is replaced atomically; and no output makes a missing folder.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

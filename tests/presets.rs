@@ -1,5 +1,7 @@
 //! The shipped presets: the seed reproduces its published numbers, and the linear presets
 //! keep the gain within 0.1 % of 1/E_avg on [0, 1] for their Blender family.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use gloffuse::fit::Weighting;
 use gloffuse::fit::{Coefficients, Target};

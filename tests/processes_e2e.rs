@@ -7,6 +7,8 @@
 //! - SIGTERM and SIGHUP stop Blender like Ctrl-C: exit 128 + the signal, the user's file
 //!   byte-identical, no temporary file beside it;
 //! - a closed stdout keeps the verdict: a failing `verify` still exits 1, a passing one 0.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

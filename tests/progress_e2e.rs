@@ -6,6 +6,8 @@
 //!   "Remaining" estimate while it runs, move forward only, and stay within 0 to 1.
 //! - `generate --blend` tells each distribution's groups, each preview and the save as
 //!   they begin.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -7,6 +7,8 @@
 //! PyPI. The repair is followed up to pip: the broken venv is removed, a fresh venv is made
 //! with the real Python 3.11, and pip (offline) fails; the same install path with a
 //! reachable PyPI is what `tests/blender_runner.rs` covers for a first install.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -6,6 +6,8 @@
 //! ruff comes from `$GLOFFUSE_TEST_RUFF`, which `scripts/test.sh` sets after installing
 //! ruff from PyPI. Unset, the test fails, unless `GLOFFUSE_SKIP_RUFF_TESTS=1` is set:
 //! then it says what it skipped and passes.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -2,6 +2,8 @@
 //! encoding of the composited render, the plot is drawn, and a failed write leaves no file.
 //!
 //! Set `GLOFFUSE_PNG_SAMPLES=DIR` to also keep the produced PNGs in DIR for a look.
+//!
+//! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use std::path::{Path, PathBuf};
 

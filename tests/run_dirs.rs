@@ -1,6 +1,8 @@
 //! Run folders under the shared cache (issue 20, case 10): pruning keeps the newest
 //! `KEEP`, removes older ones whose process has ended, and never touches a live run — a
 //! real `gloffuse verify` rendering in real Blender 3.4 while 25 newer runs are made.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -2,6 +2,8 @@
 //! by one in a temporary environment (never the whole suite, never the real caches).
 //! Not tested here: installing python3-venv or Debian's blender with apt-get (that needs a
 //! machine without them, and root).
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

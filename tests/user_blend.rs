@@ -2,6 +2,8 @@
 //! a newer file is not downgraded, the file keeps its mode, its compression and its
 //! relative paths (through a symbolic link too), and a failing run leaves the file and its
 //! earlier `.blend1` byte for byte as they were, with no temporary file beside them.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

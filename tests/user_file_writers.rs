@@ -14,6 +14,8 @@
 //! - a library whose catalog file cannot be replaced stays as it was, catalogs and all;
 //! - a stop between Blender runs leaves no temporary file or staging folder behind and says
 //!   which files were already written.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

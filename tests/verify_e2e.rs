@@ -3,6 +3,8 @@
 //! Two independent routes must agree: Cycles' rendered furnace spheres (read back from EXR)
 //! and gloffuse's integrator. And the product's promise: with the default coefficients every
 //! corrected sphere is 100 % ± 1 %; with the display-referred seed curve it is not.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 

@@ -1,6 +1,8 @@
 //! The view-dependent and multiscatter modes in real Blender: every view-cosine ring of
 //! every corrected furnace sphere within ±1.5 % of 100 %, for all three distributions at
 //! r ∈ {0.25, 0.5, 0.75, 1}, where the roughness-only correction leaves rings far off.
+//!
+//! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
 mod common;
 
