@@ -374,6 +374,68 @@ mod tests {
         }
     }
 
+    /// The quoted strings that follow each of `openings` in `text`.
+    fn quoted_after<'a>(text: &'a str, openings: &[&str]) -> Vec<&'a str> {
+        let mut found = Vec::new();
+        for opening in openings {
+            for (i, _) in text.match_indices(opening) {
+                let rest = &text[i + opening.len()..];
+                found.extend(rest.split('"').next());
+            }
+        }
+        found
+    }
+
+    /// The rule ids the Python job reports and replaces are the catalogue's, and every
+    /// catalogue rule is reported by it: the two sides agree without a Blender.
+    #[test]
+    fn the_python_detectors_report_exactly_the_catalogues_rules() {
+        let py = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../blender/gloffuse_blender/"
+        );
+        let read = |name: &str| std::fs::read_to_string(format!("{py}{name}")).unwrap();
+        let (rules, job, twin) = (
+            read("audit_rules.py"),
+            read("audit_job.py"),
+            read("audit_twin.py"),
+        );
+        let openings = [
+            "finding(\"",
+            "\"rule\": \"",
+            "rule_microfacet_single_scatter(\"",
+        ];
+        let mut reported = quoted_after(&rules, &openings);
+        reported.extend(quoted_after(&job, &openings));
+        for id in &reported {
+            assert!(
+                rule(id).is_some(),
+                "the job reports {id}, which the catalogue lacks"
+            );
+        }
+        for r in RULES {
+            assert!(
+                reported.contains(&r.id),
+                "no detector in the job reports {}",
+                r.id
+            );
+        }
+        let replaced = twin
+            .split("REPLACEMENTS = {")
+            .nth(1)
+            .expect("audit_twin's table");
+        let replaced = replaced.split('}').next().unwrap();
+        let keys = quoted_after(replaced, &["\n    \""]);
+        assert!(keys.len() >= 5, "{keys:?}");
+        for id in keys {
+            assert!(
+                rule(id).is_some(),
+                "audit_twin replaces {id}, which the catalogue lacks"
+            );
+        }
+        assert_eq!(quoted_after("x finding(\"a-b\", y)", &openings), ["a-b"]);
+    }
+
     #[test]
     fn a_white_ggx_lobe_at_roughness_1_keeps_41_percent() {
         // The measured furnace mean in Blender 4.5 and 5.0 is 0.409 (64 px, 32 spp).
