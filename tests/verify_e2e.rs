@@ -272,7 +272,8 @@ fn verify_refuses_bad_input_before_rendering() {
 /// CPython's own XML parser reads, with one test case per sphere, failures exactly where
 /// the table says FAIL, measured/predicted/tolerance properties, and the message and rerun
 /// command on each failure; and report.html, loaded and screenshotted by a real headless
-/// Chromium, whose banner shows the verdict's colour.
+/// Chromium, whose banner shows the verdict's colour, with the brightness plot on the page
+/// and the deviation column saying why a sphere judged on its mean has a coloured disc.
 #[test]
 fn junit_and_html_reports_of_a_failing_check() {
     let Some(blender) = common::blender::real_blender("4.5") else {
@@ -366,6 +367,16 @@ fn junit_and_html_reports_of_a_failing_check() {
     assert!(html.contains(&headline), "{headline}");
     assert!(html.contains("worst ring (not judged)"));
     assert!(html.find("class=\"legend\"").unwrap() < html.find("<th>status</th>").unwrap());
+    // Why an ok sphere's disc is coloured, in the deviation column's own header; the
+    // brightness plot on the page, above the table, and in the folder.
+    let header = &html[html.find("<th>deviation").unwrap()..];
+    let header = &header[..header.find("</th>").unwrap()];
+    assert!(header.contains("corrects the mean only"), "{header}");
+    let plot = html
+        .find("<img class=\"plot\" src=\"brightness.png\"")
+        .unwrap();
+    assert!(plot < html.find("<th>status</th>").unwrap());
+    assert!(report.join("brightness.png").is_file());
     column_labels_sit_over_the_cells(&report.join("deviation.png"));
     let Some(chromium) = common::browser() else {
         return;

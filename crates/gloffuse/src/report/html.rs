@@ -44,6 +44,7 @@ pub fn render(report: &VerifyReport, rendered: &Rendered, rerun: &str, files: &[
     write_thresholds(&mut s, report);
     write_rerun(&mut s, report, rerun);
     write_notes(&mut s, report);
+    write_plot(&mut s, files);
     write_spheres(&mut s, report, rendered);
     write_reference(&mut s, report, rendered);
     write_files(&mut s, files);
@@ -63,6 +64,8 @@ fn write_head(s: &mut String, verdict: &str, pass: bool) {
          tr.fail td {{ background: #fdecea; }}\n\
          td.fail {{ color: {FAIL_COLOUR}; font-weight: bold; }} td.ok {{ color: {PASS_COLOUR}; }}\n\
          img {{ image-rendering: pixelated; width: 96px; height: 96px; display: block; }}\n\
+         img.plot {{ image-rendering: auto; width: auto; height: auto; max-width: 100%; }}\n\
+         th small {{ display: block; font-weight: normal; max-width: 14em; }}\n\
          pre {{ background: #eee; padding: 6px 10px; white-space: pre-wrap; word-break: break-all; }}\n\
          .legend {{ width: 360px; margin: 4px 0 8px; }} .scope {{ max-width: 60em; }} .caption {{ white-space: nowrap; }}\n\
          .ticks {{ display: flex; justify-content: space-between; font-size: 12px; }}\n\
@@ -148,15 +151,34 @@ fn write_notes(s: &mut String, report: &VerifyReport) {
     s.push_str("</ul>\n");
 }
 
+/// The brightness plot (`brightness.png`, when the report has one) on the page itself: the
+/// clearest picture of what the check found.
+fn write_plot(s: &mut String, files: &[String]) {
+    if files.iter().any(|f| f == PLOT) {
+        let _ = writeln!(
+            s,
+            "<h2>Brightness against roughness</h2><img class=\"plot\" src=\"{PLOT}\" \
+             alt=\"brightness against roughness, rendered and predicted\">"
+        );
+    }
+}
+
+/// The brightness plot's file name in a report folder.
+pub const PLOT: &str = "brightness.png";
+
 /// The spheres' table, failures first: numbers, two thumbnails and the false-colour one.
 fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
     // Layered mode compares the hand-made Mix Shader with the layered group, glass mode
     // Blender's Glass BSDF with the glass group.
     let (plain, fixed) = words::sphere_names(report.mode);
-    let ring = if report.mode.per_pixel() {
-        "worst ring"
+    let (ring, deviation) = if report.mode.per_pixel() {
+        ("worst ring", String::new())
     } else {
-        "worst ring (not judged)"
+        // Where the eye lands on a coloured disc beside an ok: why it is coloured.
+        (
+            "worst ring (not judged)",
+            format!("<small>{}</small>", escape(MEAN_ONLY)),
+        )
     };
     s.push_str("<h2>Spheres</h2>");
     write_scale(s);
@@ -164,7 +186,7 @@ fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
         s,
         "<table><tr><th>status</th><th>sphere</th><th>{plain}</th>\
          <th>{fixed}</th><th>predicted</th><th>±SE</th><th>{ring}</th>\
-         <th>{plain}</th><th>{fixed}</th><th>deviation</th></tr>",
+         <th>{plain}</th><th>{fixed}</th><th>deviation{deviation}</th></tr>",
     );
     let mut rows: Vec<_> = report.rows.iter().collect();
     rows.sort_by_key(|r| r.pass);
@@ -173,6 +195,11 @@ fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
     }
     s.push_str("</table>\n");
 }
+
+/// Why a sphere judged on its mean alone has a coloured deviation disc.
+const MEAN_ONLY: &str = "this mode corrects the mean only: a passing sphere's centre stays \
+                         darker and its rim brighter than 100 %, so its disc is coloured (the \
+                         view mode corrects every pixel)";
 
 /// One sphere's row of the spheres' table.
 fn write_sphere_row(s: &mut String, row: &Row, rendered: &Rendered) {

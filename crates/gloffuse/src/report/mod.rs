@@ -54,7 +54,7 @@ pub fn write_files(
         &columns,
         &sheet,
     )?;
-    let plot = dir.join("brightness.png");
+    let plot = dir.join(html::PLOT);
     png::brightness_plot(report, &plot)?;
     let false_colour = dir.join("deviation.png");
     deviation::sheet(report, rendered, &false_colour)?;
