@@ -42,11 +42,22 @@ def feed(tree, target, socket):
         target.default_value = socket.default_value
 
 
+def group_node(tree, group, location):
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.location = location
+    return node
+
+
+def shader_output(node):
+    return next(s for s in node.outputs if s.type == "SHADER")
+
+
 def replace_node(tree, old, new):
     """Put `new` where `old` was: location, parent, outgoing shader links, name."""
     new.location = old.location
     new.parent = old.parent
-    shader_out = next(sock for sock in new.outputs if sock.type == "SHADER")
+    shader_out = shader_output(new)
     for out in old.outputs:
         for link in list(out.links):
             if out.type == "SHADER":
@@ -62,8 +73,7 @@ def group_in_place(tree, old, group_name, inputs, values=None):
     group = bpy.data.node_groups.get(group_name)
     if group is None:
         return False
-    node = tree.nodes.new("ShaderNodeGroup")
-    node.node_tree = group
+    node = group_node(tree, group, old.location)
     for name, value in (values or {}).items():
         node.inputs[name].default_value = value
     for name, socket in inputs.items():
@@ -118,17 +128,6 @@ def principled_layered_twin(tree, node, item):
     return True
 
 
-def group_node(tree, group, location):
-    node = tree.nodes.new("ShaderNodeGroup")
-    node.node_tree = group
-    node.location = location
-    return node
-
-
-def shader_output(node):
-    return next(s for s in node.outputs if s.type == "SHADER")
-
-
 def mix_layered_twin(tree, node, item):
     parts = layering_parts(node)
     if parts is None:
@@ -155,7 +154,7 @@ def add_scaled(tree, node, item):
     mix.inputs[0].default_value = 1.0 - scale
     mix.location = node.location.x + 200, node.location.y
     mix.parent = node.parent
-    out = next(sock for sock in node.outputs if sock.type == "SHADER")
+    out = shader_output(node)
     for link in list(out.links):
         tree.links.new(mix.outputs["Shader"], link.to_socket)
     tree.links.new(out, mix.inputs[1])

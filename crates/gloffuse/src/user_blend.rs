@@ -339,40 +339,35 @@ fn changed_since(meta: &std::fs::Metadata, when: SystemTime) -> bool {
     changed >= (since.as_secs() as i64, i64::from(since.subsec_nanos()))
 }
 
-/// Whether a file saved by `saved_by` is newer (by major.minor) than `blender`.
 /// What a file newer than the Blender that would save it needs: a Blender as new, which
 /// gloffuse has itself for a file up to its own bpy's series (found unless a Blender is
 /// named or installing is off), or accepting the loss.
 fn downgrade_hint(saved_by: BlenderVersion, blender: BlenderVersion) -> Hint {
-    let lost = format!(
-        "a file saved by Blender {blender} or older: this one was saved by Blender \
-         {saved_by}, and saving it from {blender} would lose what {blender} does not know"
-    );
-    if newer(saved_by, crate::blender::BPY_VERSION) {
-        return Hint::new(
+    let bpy = crate::blender::BPY_VERSION;
+    let (own, own_fields) = if newer(saved_by, bpy) {
+        (String::new(), vec![])
+    } else {
+        (
             format!(
-                "{lost} (run a Blender {saved_by} or newer with {{}}, or accept the loss with \
-                 {{}})"
+                "gloffuse's own bpy {bpy} reads it: leave out {{}} and {{}} to have it found \
+                 or installed; or "
             ),
-            [Field::Blender, Field::AllowDowngrade],
-        );
-    }
+            vec![Field::Blender, Field::NoProvision],
+        )
+    };
     Hint::new(
         format!(
-            "{lost} (gloffuse's own bpy {} reads it: leave out {{}} and {{}} to have it found \
-             or installed; or run a Blender {saved_by} or newer with {{}}, or accept the loss \
-             with {{}})",
-            crate::blender::BPY_VERSION
+            "a file saved by Blender {blender} or older: this one was saved by Blender \
+             {saved_by}, and saving it from {blender} would lose what {blender} does not know \
+             ({own}run a Blender {saved_by} or newer with {{}}, or accept the loss with {{}})"
         ),
-        [
-            Field::Blender,
-            Field::NoProvision,
-            Field::Blender,
-            Field::AllowDowngrade,
-        ],
+        own_fields
+            .into_iter()
+            .chain([Field::Blender, Field::AllowDowngrade]),
     )
 }
 
+/// Whether a file saved by `saved_by` is newer (by major.minor) than `blender`.
 fn newer(saved_by: BlenderVersion, blender: BlenderVersion) -> bool {
     (saved_by.major, saved_by.minor) > (blender.major, blender.minor)
 }

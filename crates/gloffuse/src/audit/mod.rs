@@ -870,13 +870,15 @@ fn failed_file(file: &Path, e: &Error, blender: BlenderVersion) -> AuditedFile {
 /// Why a Blender older than a file failed on it, in a sentence: what to run instead, then
 /// Blender's last error line (or how it ended: a crash has none) and its log's path.
 fn too_new(e: &Error, saved: BlenderVersion, blender: BlenderVersion) -> String {
-    let text = e.to_string();
-    let lines: Vec<&str> = text.lines().map(str::trim).collect();
-    let log = lines.iter().position(|l| l.starts_with("log:"));
+    let (message, log) = match e {
+        Error::Blender { message, log, .. } => (message.to_string(), log.as_deref()),
+        other => (other.to_string(), None),
+    };
+    let lines: Vec<&str> = message.lines().map(str::trim).collect();
     let ended = lines
         .first()
         .map_or("", |l| l.split(';').next().unwrap_or(l));
-    let said = lines[..log.unwrap_or(lines.len())]
+    let said = lines
         .iter()
         .rev()
         .find(|l| l.contains("Error"))
@@ -886,8 +888,8 @@ fn too_new(e: &Error, saved: BlenderVersion, blender: BlenderVersion) -> String 
         "Blender {blender} could not audit this file, saved by the newer Blender {saved}: \
          audit it in Blender {saved} or later ({said})"
     );
-    if let Some(log) = log.map(|i| lines[i]) {
-        words.push_str(&format!("; {log}"));
+    if let Some(log) = log {
+        words.push_str(&format!("; log: {}", log.display()));
     }
     words
 }
