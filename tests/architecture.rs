@@ -1,6 +1,8 @@
-//! The structure docs/ARCHITECTURE.md describes, checked: which crate may depend on what,
-//! which stage may import which, that the library never names a command-line flag, and
-//! that a long function says why it is long.
+//! The structure docs/ARCHITECTURE.md describes, checked: which crate may depend on what
+//! (the physics crate, the library and the binary each have their list), which stage may
+//! import which (grouped `use crate::{…}` included), that the library never names a
+//! command-line flag, that a long function says why it is long, and that the module map
+//! names every Rust file.
 //!
 //! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
@@ -71,6 +73,27 @@ fn the_physics_crate_has_no_blender_io_or_cli_dependencies() {
 }
 
 #[test]
+fn the_binary_depends_only_on_the_library_and_the_command_line_crates() {
+    let deps = dependencies(&root().join("Cargo.toml"));
+    let allowed = [
+        "gloffuse",
+        "clap",
+        "indicatif",
+        "libc",
+        "serde",
+        "serde_json",
+    ];
+    for dep in &deps {
+        assert!(
+            allowed.contains(&dep.as_str()),
+            "the binary depends on {dep}: work beyond parsing and printing belongs in the \
+             library (allowed: {allowed:?})"
+        );
+    }
+    assert!(deps.contains("clap"), "the manifest was read: {deps:?}");
+}
+
+#[test]
 fn the_library_depends_on_no_cli_crate() {
     let deps = dependencies(&root().join(LIBRARY).join("Cargo.toml"));
     assert!(
@@ -83,23 +106,62 @@ fn the_library_depends_on_no_cli_crate() {
 }
 
 /// `crate::x` (and `gloffuse_physics::x`) module names a file's code (not its comments)
-/// refers to.
+/// refers to, grouped ones included: `use crate::{audit, report::html}` names `audit` and
+/// `report`.
 fn imported_modules(text: &str) -> BTreeSet<String> {
     let text: String = text.lines().map(|l| format!("{}\n", code_of(l))).collect();
     let mut names = BTreeSet::new();
     for prefix in ["crate::", "gloffuse_physics::"] {
         for (i, _) in text.match_indices(prefix) {
             let rest = &text[i + prefix.len()..];
-            let name: String = rest
-                .chars()
-                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-                .collect();
-            if !name.is_empty() {
-                names.insert(name);
+            match rest.strip_prefix('{') {
+                Some(group) => names.extend(group_heads(group)),
+                None => names.extend(leading_name(rest)),
             }
         }
     }
     names
+}
+
+/// The identifier `text` starts with, if any.
+fn leading_name(text: &str) -> Option<String> {
+    let name: String = text
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect();
+    (!name.is_empty()).then_some(name)
+}
+
+/// The first name of each item of a `{…}` group, up to its closing brace (nested groups
+/// belong to their item).
+fn group_heads(group: &str) -> Vec<String> {
+    let mut heads = Vec::new();
+    let mut depth = 0;
+    let mut item_start = true;
+    for (i, c) in group.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => break,
+            '}' => depth -= 1,
+            ',' if depth == 0 => item_start = true,
+            c if item_start && !c.is_whitespace() => {
+                heads.extend(leading_name(&group[i..]));
+                item_start = false;
+            }
+            _ => {}
+        }
+    }
+    heads
+}
+
+#[test]
+fn grouped_imports_are_read() {
+    let text =
+        "use crate::{\n    audit::{self, x},\n    report, // why\n};\nuse crate::fit::Curve;";
+    let found = imported_modules(text);
+    let want: BTreeSet<String> = ["audit", "report", "fit"].map(String::from).into();
+    assert_eq!(found, want);
 }
 
 #[test]
@@ -374,4 +436,85 @@ fn the_tier_check_can_fail() {
     );
     assert_eq!(tier_of("//! Tier: blender.\n"), Some("blender"));
     assert_eq!(tier_of("//! A test.\nfn x() {}\n//! Tier: fast\n"), None);
+}
+
+/// The module map's rows: the paths in the first cell (a file, or a folder ending in `/`)
+/// and the whole row's text.
+fn module_map_rows(doc: &str) -> Vec<(Vec<String>, String)> {
+    let section = doc
+        .split("\n## Module map")
+        .nth(1)
+        .expect("docs/ARCHITECTURE.md has a \"Module map\" section");
+    let section = section.split("\n## ").next().unwrap();
+    let mut rows = Vec::new();
+    for line in section.lines().filter(|l| l.starts_with("| `")) {
+        let first_cell = line.split('|').nth(1).unwrap_or("");
+        let paths = first_cell
+            .split('`')
+            .skip(1)
+            .step_by(2)
+            .filter(|p| p.starts_with("crates/") || p.starts_with("src/"))
+            .map(String::from)
+            .collect();
+        rows.push((paths, line.to_string()));
+    }
+    rows
+}
+
+/// Whether a row names `file` (relative to the root): by its path, or, in a row of its
+/// folder (a folder above it, or a file beside it), by its name in backticks.
+fn row_names(paths: &[String], text: &str, file: &str) -> bool {
+    let (dir, name) = file.rsplit_once('/').unwrap();
+    let stem = name.trim_end_matches(".rs");
+    let of_its_folder = paths.iter().any(|p| match p.strip_suffix('/') {
+        Some(folder) => dir == folder || dir.starts_with(&format!("{folder}/")),
+        None => p.rsplit_once('/').is_some_and(|(d, _)| d == dir),
+    });
+    paths.iter().any(|p| p == file)
+        || of_its_folder
+            && (text.contains(&format!("`{name}`")) || text.contains(&format!("`{stem}`")))
+}
+
+#[test]
+fn the_module_map_names_every_rust_file() {
+    let doc = fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let rows = module_map_rows(&doc);
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for dir in [PHYSICS, LIBRARY, "."] {
+        let src = root().join(dir).join("src");
+        for file in rust_files(&src) {
+            let relative = file
+                .strip_prefix(root())
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            if !rows
+                .iter()
+                .any(|(paths, text)| row_names(paths, text, &relative))
+            {
+                missing.push(relative);
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 60, "only {checked} files checked");
+    assert!(
+        missing.is_empty(),
+        "docs/ARCHITECTURE.md's module map does not name {missing:#?}"
+    );
+}
+
+#[test]
+fn the_module_map_check_can_fail() {
+    let doc = "\n## Module map\n\n| path | what |\n|---|---|\n\
+               | `src/cli/` | `args.rs` (clap), `farm/` |\n\
+               | `crates/gloffuse/src/verify/image.rs`, `stats.rs` | EXR |\n\n## Next\n";
+    let rows = module_map_rows(doc);
+    let named = |file: &str| rows.iter().any(|(p, t)| row_names(p, t, file));
+    assert!(named("src/cli/args.rs"));
+    assert!(named("crates/gloffuse/src/verify/stats.rs"));
+    assert!(!named("src/cli/text.rs"));
+    assert!(!named("crates/gloffuse/src/verify/plan.rs"));
+    assert!(!named("crates/gloffuse/src/audit/stats.rs"));
 }
