@@ -14,7 +14,7 @@
 mod xorshift;
 
 use gloffuse::generate::ColorModel;
-use gloffuse::generate::params::{GlassGroup, GlassTable};
+use gloffuse::generate::tables::{GlassGroup, GlassTable};
 use gloffuse::measure::coat::slice_coordinate;
 use gloffuse::measure::{
     BlenderVersion, Dielectric, DielectricIntegrator, DielectricNode, Distribution, Masking,

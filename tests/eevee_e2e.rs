@@ -11,7 +11,7 @@
 
 mod common;
 
-use gloffuse::generate::params::in_eevee;
+use gloffuse::generate::document::in_eevee;
 use gloffuse::measure::{Distribution, Glossy, Masking, Roughness};
 use gloffuse::verify::verdict::MIN_RING_PIXELS;
 use serde_json::Value;

@@ -8,7 +8,7 @@ use gloffuse::lut::split_sum::{
     Estimate, Rule, Sampler, split_sum, split_sum_texel_quadrature, split_sum_texel_sampled,
 };
 use gloffuse::lut::{
-    Bits, Format, GModel, Kind, LutOptions, Method, Spec, Table, kulla_conty, lut,
+    Bits, Bsdf, Format, GModel, Kind, LutOptions, Method, Spec, Table, kulla_conty, lut,
 };
 use gloffuse::measure::BlenderVersion;
 use gloffuse::measure::{AlbedoIntegrator, Distribution, Glossy, Masking, Quadrature, Roughness};
@@ -328,10 +328,13 @@ fn the_default_method_is_the_default_rule() {
     let args = LutOptions::new(Kind::SplitSum, "unused.exr");
     assert_eq!(
         Spec::from_options(&args).unwrap(),
-        Spec::SplitSum {
+        Spec {
+            kind: Kind::SplitSum,
             size: 512,
-            g_model: GModel::Ue4,
-            estimate: QUADRATURE,
+            bsdf: Bsdf::SplitSum {
+                g_model: GModel::Ue4,
+                estimate: QUADRATURE,
+            },
         }
     );
 }

@@ -1,21 +1,26 @@
 //! ③ Generate: the node groups as a Python script, a new .blend, or into an existing .blend.
-//! `params` is the parameter document, `bundle` turns the Blender-side Python package into
-//! single-file scripts, `script` assembles a job's script, `blend` checks what
-//! Blender wrote.
+//! `vocabulary` holds the modes and colour models, `tables` the packed tables the groups
+//! read, `names` the groups' public names, `document` the parameter document; `bundle`
+//! turns the Blender-side Python package into single-file scripts, `script` assembles a
+//! job's script, `blend` checks what Blender wrote.
 
 pub mod blend;
 pub mod bundle;
 pub mod catalogs;
+pub mod document;
 pub mod extension;
-pub mod params;
+pub mod names;
 pub mod script;
 pub mod suits;
+pub mod tables;
+pub mod vocabulary;
 
-pub use params::{
-    ColorModel, Curves, GenerateParams, GroupSpec, Mode, correction_group_name, layered_group_name,
-    multiscatter_group_name, shader_group_name,
+pub use document::{Curves, GenerateParams, GroupSpec};
+pub use names::{
+    correction_group_name, layered_group_name, multiscatter_group_name, shader_group_name,
 };
 pub use script::{Job, assemble, assemble_with_main};
+pub use vocabulary::{ColorModel, Mode};
 
 use serde::Serialize;
 use std::ffi::OsString;

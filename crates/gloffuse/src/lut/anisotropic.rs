@@ -12,10 +12,65 @@
 //! two nearest columns and rows itself; `cargo run --release --example
 //! anisotropic_table_error` measures what that lookup misses.
 
-use super::Table;
+use super::{Bsdf, KindFacts, LutOptions, SizeLimit, Spec, Table, blender_bsdf, microfacet_only};
+use crate::error::{Error, Field, Hint};
 use crate::measure::anisotropic::{AnisotropicAxes, AnisotropicIntegrator};
 use crate::measure::{Distribution, Masking};
 use crate::progress::Progress;
+
+/// The anisotropic table: its facts for `lut` (see the module's doc for its layout).
+pub const KIND: KindFacts = KindFacts {
+    key: "anisotropic",
+    default_size: 16,
+    size_limit: Some(SizeLimit {
+        min: 2,
+        max: MAX_SIZE,
+        why: || {
+            format!(
+                "its atlas holds {AZIMUTHS} × size slices of size² albedos, each a 9,216-point quadrature"
+            )
+        },
+    }),
+    bsdf,
+    channels: &[
+        "R: E(N·V, φ of the slice's column, αx = rx², αy = ry² of the slice's row)",
+        "G: E_avg(αx, αy)",
+    ],
+    steps_per_size: 2,
+    slice_iors: None,
+    slice_azimuths: Some(azimuths),
+    compute: |spec: &Spec, progress| {
+        let bsdf = spec.blender();
+        anisotropic_table(
+            spec.size,
+            bsdf.distribution,
+            bsdf.blender_version.masking(),
+            progress,
+        )
+    },
+};
+
+/// GGX or Beckmann, as a Blender version that renders the lobe renders it.
+fn bsdf(args: &LutOptions) -> Result<Bsdf, Error> {
+    let bsdf = blender_bsdf(args, None)?;
+    let (distribution, blender_version) = (bsdf.distribution, bsdf.blender_version);
+    microfacet_only(
+        distribution,
+        args.kind,
+        "the table covers the two microfacet distributions",
+    )?;
+    if !blender_version.renders_anisotropic(distribution) {
+        return Err(Error::input(
+            Field::BlenderVersion,
+            blender_version,
+            Hint::new(
+                "3.5 or later with {} beckmann {} anisotropic (Blender 3.0–3.4 sample an isotropic lobe for anisotropic Beckmann, so they do not render the lobe this table describes; GGX is right in every version)",
+                [Field::Distribution, Field::Kind],
+            ),
+        ));
+    }
+    Ok(Bsdf::Blender(bsdf))
+}
 
 /// View azimuths per table: a column of slices for each. Near grazing, a view along the
 /// narrow axis changes E steeply with φ: 8 columns miss it by 4.6 %, 16 by 2.6 %.

@@ -9,10 +9,35 @@
 //! lobe's albedo (so a renderer whose own lobe reflects E can weight it by A / E). A base
 //! under the coat is weighted by `1 − A`.
 
-use super::Table;
+use super::{Bsdf, KindFacts, SizeLimit, Spec, Table, blender_bsdf};
 use crate::measure::coat::{SLICES, slice_iors};
 use crate::measure::{AlbedoIntegrator, Distribution, Masking, Roughness};
 use crate::progress::Progress;
+
+/// The coat table: its facts for `lut` (see the module's doc for its layout).
+pub const KIND: KindFacts = KindFacts {
+    key: "coat",
+    default_size: 64,
+    size_limit: Some(SizeLimit {
+        min: 1,
+        max: MAX_SIZE,
+        why: || format!("its atlas is {SLICES} slices wide"),
+    }),
+    bsdf: |args| blender_bsdf(args, None).map(Bsdf::Blender),
+    channels: &["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
+    steps_per_size: 1,
+    slice_iors: Some(ior),
+    slice_azimuths: None,
+    compute: |spec: &Spec, progress| {
+        let bsdf = spec.blender();
+        coat_table(
+            spec.size,
+            bsdf.distribution,
+            bsdf.blender_version.masking(),
+            progress,
+        )
+    },
+};
 
 /// The largest `--size` of a coat table: 12 slices of 1024 make a 12288-texel-wide atlas,
 /// within what GPUs sample (16384).

@@ -10,11 +10,42 @@
 //! R = E of the Glass BSDF (reflection and refraction), G = E of the Refraction BSDF. A
 //! renderer divides its single-scattering lobe by E to keep every interface's energy.
 
-use super::Table;
+use super::{Bsdf, KindFacts, SizeLimit, Spec, Table, blender_bsdf, microfacet_only};
 use crate::measure::coat::SLICES;
 use crate::measure::dielectric::{DielectricNode, Side};
 use crate::measure::{BlenderVersion, DielectricIntegrator, Distribution, Roughness};
 use crate::progress::Progress;
+
+/// The glass table: its facts for `lut` (see the module's doc for its layout).
+pub const KIND: KindFacts = KindFacts {
+    key: "glass",
+    default_size: 32,
+    size_limit: Some(SizeLimit {
+        min: 1,
+        max: MAX_SIZE,
+        why: || format!("its atlas is {SLICES} slices wide and two high"),
+    }),
+    bsdf: |args| {
+        let bsdf = blender_bsdf(args, None)?;
+        microfacet_only(
+            bsdf.distribution,
+            args.kind,
+            "Blender's Glass and Refraction BSDFs have no Ashikhmin-Shirley",
+        )?;
+        Ok(Bsdf::Blender(bsdf))
+    },
+    channels: &[
+        "R: E(μ, r, η) of the Glass BSDF, η = IOR of the slice (top row) or 1/IOR (bottom row)",
+        "G: E(μ, r, η) of the Refraction BSDF",
+    ],
+    steps_per_size: 1,
+    slice_iors: Some(super::coat::ior),
+    slice_azimuths: None,
+    compute: |spec: &Spec, progress| {
+        let bsdf = spec.blender();
+        glass_table(spec.size, bsdf.distribution, bsdf.blender_version, progress)
+    },
+};
 
 /// The largest `--size`: 12 slices of 256 make a 3072-texel-wide atlas of 1.6 million
 /// albedos, several minutes on two cores.

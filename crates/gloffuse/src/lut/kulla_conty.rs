@@ -30,10 +30,42 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-use super::Table;
 use super::split_sum::{disk_point, hammersley};
+use super::{Bsdf, KindFacts, Spec, Table, blender_bsdf};
 use crate::measure::{AlbedoGrid, AlbedoIntegrator, Distribution, Glossy, Masking, Roughness};
 use crate::progress::Progress;
+
+/// The Kulla–Conty table: its facts for `lut` (see the module's doc for its layout).
+pub const KIND: KindFacts = KindFacts {
+    key: "kulla-conty",
+    default_size: 64,
+    size_limit: None,
+    bsdf: |args| blender_bsdf(args, Some(DEFAULT_SAMPLES)).map(Bsdf::Blender),
+    channels: &[
+        "R: scale",
+        "G: bias",
+        "B: integral of f_ms cos (≈ 1 − E)",
+        "A: E_avg(r)",
+    ],
+    steps_per_size: 2,
+    slice_iors: None,
+    slice_azimuths: None,
+    compute: |spec: &Spec, progress| {
+        let bsdf = spec.blender();
+        let samples = bsdf.samples.expect("a Kulla–Conty request is sampled");
+        kulla_conty(
+            spec.size,
+            samples,
+            bsdf.distribution,
+            bsdf.blender_version.masking(),
+            progress,
+        )
+        .table()
+    },
+};
+
+/// Hammersley samples per texel when none are asked for.
+const DEFAULT_SAMPLES: u32 = 4096;
 
 /// The Kulla–Conty tables of one Glossy BSDF, each row-major with row y at
 /// `μ = (y + ½)/size` and column x at `r = (x + ½)/size`.

@@ -10,37 +10,13 @@
 //!
 //! # Kinds
 //!
-//! * [`Kind::SplitSum`], 2 channels: **R = scale, G = bias**, the classic GGX "BRDF
-//!   generator" (see [`split_sum`]); at run time `specular = F0 · scale + bias`. By default
-//!   computed by deterministic quadrature (no samples): 512² within 2.2e-5 of the converged
-//!   table (`cargo bench --bench lut`); `--method classic` is the textbook estimator
-//!   verbatim, with `--samples` (1e-2 off near grazing at 1024 samples).
-//! * [`Kind::Albedo`], 2 channels, for the same Glossy BSDF: **R = E(μ, r)** and
-//!   **G = E_avg(r)** (constant along each column), both by the deterministic quadrature of
-//!   [`crate::measure::AlbedoIntegrator`] (no samples; max error 3.2e-5): the two
-//!   Kulla–Conty tables a renderer needs to build its own compensation.
-//! * [`Kind::KullaConty`], 4 channels, for the Glossy BSDF that Cycles evaluates (chosen by
-//!   `--distribution` and `--blender-version`; see [`kulla_conty`]):
-//!   **R = scale, G = bias** (the same split-sum pair, integrated over Cycles' BSDF, so
-//!   `R + G ≈ E(μ, r)`), **B = ∫ f_ms(μ, μi) cosθi dωi** (the multiple-scattering lobe
-//!   `f_ms = (1 − E(μ))(1 − E(μi)) / (π (1 − E_avg))`, integrated in closed form; it is
-//!   `≈ 1 − E(μ)`), and **A = E_avg(r)** (constant along each column) for the Fresnel term
-//!   `F_avg E_avg / (1 − F_avg (1 − E_avg))` that scales B under a coloured Fresnel.
-//!   `E(μ, r)` itself (Cycles-exact, from [`crate::measure::AlbedoIntegrator`]) is in
-//!   [`kulla_conty::KullaConty::e`].
-//! * [`Kind::Coat`], 2 channels, the coat of the layered shader (see [`coat`]): 12 slices of
-//!   n × n side by side (an atlas 12n wide), slice k for index of refraction `ior[k]`
-//!   (listed in the summary): **R = A(μ, r, η)**, the albedo of a dielectric microfacet
-//!   coat with its lost energy given back, **G = E(μ, r)**. Quadrature, no samples.
-//!
-//! * [`Kind::Anisotropic`], 2 channels, Cycles' anisotropic GGX or Beckmann lobe (see
-//!   [`anisotropic`]): an atlas of 16 view azimuths side by side × n bitangent widths
-//!   stacked, each slice n × n over (tangent width, N·V) at grid points, not pixel centres:
-//!   **R = E(μ, φ, αx, αy)**, **G = E_avg(αx, αy)**. Quadrature, no samples.
-//! * [`Kind::Glass`], 2 channels, Cycles' Glass and Refraction BSDFs (see [`glass`]): 12
-//!   slices of n × n side by side over the index of refraction, light entering (η = IOR) in
-//!   the top row and leaving (η = 1/IOR) in the bottom one: **R = E(μ, r, η)** of the Glass
-//!   BSDF, **G = E(μ, r, η)** of the Refraction BSDF. Quadrature, no samples.
+//! Each kind is one module: [`split_sum`] (GGX's scale and bias), [`kulla_conty`] (the
+//! Kulla–Conty RGBA table of Cycles' Glossy BSDF), [`albedo`] (that BSDF's E(μ, r) and
+//! E_avg(r)), [`coat`] (the layered shader's coat), [`anisotropic`] (Cycles' anisotropic
+//! lobe) and [`glass`] (Cycles' Glass and Refraction BSDFs). Its doc comment gives its
+//! layout and channels; its `KIND` ([`KindFacts`]) is everything `lut` knows of it: its
+//! key, default size and size limit, the flags it takes, its channels' meanings, how it
+//! reports progress, its slices and how it is computed. [`Kind::facts`] registers it.
 //!
 //! # Formats
 //!
@@ -51,6 +27,7 @@
 //! * KTX 2.0 (written here, see [`ktx2`]): VK_FORMAT_R16G16_SFLOAT / R32G32_SFLOAT or
 //!   R16G16B16A16_SFLOAT / R32G32B32A32_SFLOAT, one level, no supercompression.
 
+pub mod albedo;
 pub mod anisotropic;
 pub mod coat;
 pub mod dds;
@@ -95,16 +72,51 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub fn key(self) -> &'static str {
+    /// Everything this kind's module says of it: the one registration of a kind.
+    pub fn facts(self) -> &'static KindFacts {
         match self {
-            Kind::SplitSum => "split-sum",
-            Kind::KullaConty => "kulla-conty",
-            Kind::Albedo => "albedo",
-            Kind::Coat => "coat",
-            Kind::Anisotropic => "anisotropic",
-            Kind::Glass => "glass",
+            Kind::SplitSum => &split_sum::KIND,
+            Kind::KullaConty => &kulla_conty::KIND,
+            Kind::Albedo => &albedo::KIND,
+            Kind::Coat => &coat::KIND,
+            Kind::Anisotropic => &anisotropic::KIND,
+            Kind::Glass => &glass::KIND,
         }
     }
+
+    pub fn key(self) -> &'static str {
+        self.facts().key
+    }
+}
+
+/// What one kind of table is, written once in its module (`KIND`).
+pub struct KindFacts {
+    /// Its name in the options and the summary (`split-sum`, …).
+    pub key: &'static str,
+    /// Texels per side (per slice side for an atlas) when no size is asked for.
+    pub default_size: u32,
+    /// A narrower range of sizes than 1 to [`MAX_SIZE`], for an atlas of slices.
+    pub size_limit: Option<SizeLimit>,
+    /// What the table integrates, from the options: the kind's defaults, and its refusals
+    /// of the options it does not take.
+    pub bsdf: fn(&LutOptions) -> Result<Bsdf, Error>,
+    /// What each stored channel holds, in order.
+    pub channels: &'static [&'static str],
+    /// How many times [`KindFacts::compute`] steps its progress per texel of the size.
+    pub steps_per_size: usize,
+    /// The index of refraction of each slice, in order (an atlas over the index).
+    pub slice_iors: Option<fn() -> Vec<f64>>,
+    /// The view azimuth of each column of slices, in order (an atlas over the azimuth).
+    pub slice_azimuths: Option<fn() -> Vec<f64>>,
+    /// The table of a validated request of this kind.
+    pub compute: fn(&Spec, &dyn Progress) -> Table,
+}
+
+/// The sizes an atlas of slices accepts, and why no more.
+pub struct SizeLimit {
+    pub min: u32,
+    pub max: u32,
+    pub why: fn() -> String,
 }
 
 /// The masking–shadowing term of the split-sum table.
@@ -214,14 +226,15 @@ impl Bits {
 #[derive(Clone, Debug, PartialEq)]
 pub struct LutOptions {
     pub kind: Kind,
-    /// kulla-conty and albedo: the distribution [default: GGX].
+    /// Every kind but split-sum: the distribution [default: GGX].
     pub distribution: Option<Distribution>,
-    /// kulla-conty and albedo: the Blender whose masking the BSDF follows [default: 4.5].
+    /// Every kind but split-sum: the Blender whose BSDF the table follows [default: 4.5].
     pub blender_version: Option<BlenderVersion>,
-    /// Texels per side [default: 512 split-sum, 64 otherwise].
+    /// Texels per side, per slice side for an atlas [default: the kind's
+    /// [`KindFacts::default_size`]].
     pub size: Option<u32>,
-    /// Hammersley samples per texel: kulla-conty [default: 4096] and split-sum with
-    /// [`Method::Classic`] [default: 2048]; the quadrature and albedo take none.
+    /// Hammersley samples per texel: kulla-conty and split-sum with [`Method::Classic`]
+    /// [default: their modules']; the kinds integrated by quadrature take none.
     pub samples: Option<u32>,
     /// split-sum only [default: quadrature].
     pub method: Option<Method>,
@@ -285,180 +298,78 @@ impl Table {
 
 /// What a validated request computes (parse, don't validate: built once from [`LutOptions`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Spec {
+pub struct Spec {
+    pub kind: Kind,
+    /// Texels per side (per slice side for an atlas).
+    pub size: usize,
+    pub bsdf: Bsdf,
+}
+
+/// The BSDF a table integrates, and how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bsdf {
+    /// The split-sum table's GGX: its masking term and its estimate.
     SplitSum {
-        size: usize,
         g_model: GModel,
         estimate: split_sum::Estimate,
     },
-    KullaConty {
-        size: usize,
-        samples: u32,
-        distribution: Distribution,
-        blender_version: BlenderVersion,
-    },
-    Albedo {
-        size: usize,
-        distribution: Distribution,
-        blender_version: BlenderVersion,
-    },
-    Coat {
-        size: usize,
-        distribution: Distribution,
-        blender_version: BlenderVersion,
-    },
-    Anisotropic {
-        size: usize,
-        distribution: Distribution,
-        blender_version: BlenderVersion,
-    },
-    Glass {
-        size: usize,
-        distribution: Distribution,
-        blender_version: BlenderVersion,
-    },
+    /// A BSDF of Blender's.
+    Blender(BlenderBsdf),
+}
+
+/// A BSDF as Blender `blender_version` renders it (its masking, its glass), with samples
+/// per texel where the kind samples it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlenderBsdf {
+    pub distribution: Distribution,
+    pub blender_version: BlenderVersion,
+    pub samples: Option<u32>,
 }
 
 impl Spec {
     /// Checks the numbers and the flag combinations; errors name the flag.
     pub fn from_options(args: &LutOptions) -> Result<Spec, Error> {
-        let (size, samples) = checked_counts(args)?;
-        let distribution = args.distribution.unwrap_or(Distribution::Ggx);
-        let blender_version = args.blender_version.unwrap_or(BlenderVersion::DEFAULT);
-        match args.kind {
-            Kind::SplitSum => split_sum_spec(args, size, samples),
-            Kind::KullaConty => {
-                reject_split_sum_flags(args)?;
-                Ok(Spec::KullaConty {
-                    size,
-                    samples,
-                    distribution,
-                    blender_version,
-                })
-            }
-            Kind::Albedo => {
-                reject_split_sum_flags(args)?;
-                reject_samples(args)?;
-                Ok(Spec::Albedo {
-                    size,
-                    distribution,
-                    blender_version,
-                })
-            }
-            Kind::Coat => {
-                reject_split_sum_flags(args)?;
-                reject_samples(args)?;
-                Ok(Spec::Coat {
-                    size,
-                    distribution,
-                    blender_version,
-                })
-            }
-            Kind::Anisotropic => {
-                reject_split_sum_flags(args)?;
-                reject_samples(args)?;
-                microfacet_only(
-                    distribution,
-                    args.kind,
-                    "the table covers the two microfacet distributions",
-                )?;
-                if !blender_version.renders_anisotropic(distribution) {
-                    return Err(Error::input(
-                        Field::BlenderVersion,
-                        blender_version,
-                        Hint::new(
-                            "3.5 or later with {} beckmann {} anisotropic (Blender 3.0–3.4 sample an isotropic lobe for anisotropic Beckmann, so they do not render the lobe this table describes; GGX is right in every version)",
-                            [Field::Distribution, Field::Kind],
-                        ),
-                    ));
-                }
-                Ok(Spec::Anisotropic {
-                    size,
-                    distribution,
-                    blender_version,
-                })
-            }
-            Kind::Glass => {
-                reject_split_sum_flags(args)?;
-                reject_samples(args)?;
-                microfacet_only(
-                    distribution,
-                    args.kind,
-                    "Blender's Glass and Refraction BSDFs have no Ashikhmin-Shirley",
-                )?;
-                Ok(Spec::Glass {
-                    size,
-                    distribution,
-                    blender_version,
-                })
-            }
-        }
+        let facts = args.kind.facts();
+        let size = checked_counts(args, facts)?;
+        Ok(Spec {
+            kind: args.kind,
+            size,
+            bsdf: (facts.bsdf)(args)?,
+        })
     }
 
     /// How many times [`Spec::compute`] steps its `progress`.
     pub fn progress_steps(&self) -> usize {
-        match *self {
-            Spec::SplitSum { size, .. }
-            | Spec::Albedo { size, .. }
-            | Spec::Coat { size, .. }
-            | Spec::Glass { size, .. } => size,
-            Spec::KullaConty { size, .. } | Spec::Anisotropic { size, .. } => 2 * size,
-        }
+        self.kind.facts().steps_per_size * self.size
     }
 
     /// Computes the table.
     pub fn compute(&self, progress: &dyn Progress) -> Table {
-        match *self {
-            Spec::SplitSum {
-                size,
-                g_model,
-                estimate,
-            } => Table {
-                width: size,
-                height: size,
-                channels: &["R", "G"],
-                data: split_sum::split_sum(size, g_model, estimate, progress),
-            },
-            Spec::KullaConty {
-                size,
-                samples,
-                distribution,
-                blender_version,
-            } => kulla_conty::kulla_conty(
-                size,
-                samples,
-                distribution,
-                blender_version.masking(),
-                progress,
-            )
-            .table(),
-            Spec::Albedo {
-                size,
-                distribution,
-                blender_version,
-            } => kulla_conty::albedo_table(size, distribution, blender_version.masking(), progress),
-            Spec::Coat {
-                size,
-                distribution,
-                blender_version,
-            } => coat::coat_table(size, distribution, blender_version.masking(), progress),
-            Spec::Anisotropic {
-                size,
-                distribution,
-                blender_version,
-            } => anisotropic::anisotropic_table(
-                size,
-                distribution,
-                blender_version.masking(),
-                progress,
-            ),
-            Spec::Glass {
-                size,
-                distribution,
-                blender_version,
-            } => glass::glass_table(size, distribution, blender_version, progress),
+        (self.kind.facts().compute)(self, progress)
+    }
+
+    /// The BSDF of a Blender table (every kind but split-sum), for its module's `compute`.
+    fn blender(&self) -> BlenderBsdf {
+        match self.bsdf {
+            Bsdf::Blender(bsdf) => bsdf,
+            Bsdf::SplitSum { .. } => unreachable!("only split-sum's own request is its GGX"),
         }
     }
+}
+
+/// A table of Blender's BSDF: the distribution and version asked for (else GGX in the
+/// default Blender), no split-sum option, and samples only where the kind samples
+/// (`default_samples`).
+fn blender_bsdf(args: &LutOptions, default_samples: Option<u32>) -> Result<BlenderBsdf, Error> {
+    reject_split_sum_flags(args)?;
+    if default_samples.is_none() {
+        reject_samples(args)?;
+    }
+    Ok(BlenderBsdf {
+        distribution: args.distribution.unwrap_or(Distribution::Ggx),
+        blender_version: args.blender_version.unwrap_or(BlenderVersion::DEFAULT),
+        samples: default_samples.map(|n| args.samples.unwrap_or(n)),
+    })
 }
 
 /// GGX or Beckmann: the kinds whose table covers only the two microfacet distributions.
@@ -476,18 +387,10 @@ fn microfacet_only(distribution: Distribution, kind: Kind, why: &str) -> Result<
     ))
 }
 
-/// The table's size and samples per texel, the kind's defaults where not given, checked
-/// against the limits (a coat slice against its atlas's).
-fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
-    let (default_size, default_samples) = match args.kind {
-        Kind::SplitSum => (512, 2048),
-        Kind::KullaConty => (64, 4096),
-        Kind::Albedo | Kind::Coat => (64, 1),
-        Kind::Anisotropic => (16, 1),
-        Kind::Glass => (32, 1),
-    };
-    let size = args.size.unwrap_or(default_size);
-    let samples = args.samples.unwrap_or(default_samples);
+/// The table's size, the kind's default where not given, and the samples asked for,
+/// checked against the limits (a slice against its atlas's).
+fn checked_counts(args: &LutOptions, facts: &KindFacts) -> Result<usize, Error> {
+    let size = args.size.unwrap_or(facts.default_size);
     if size == 0 || size > MAX_SIZE {
         return Err(Error::input(
             Field::Size,
@@ -495,105 +398,35 @@ fn checked_counts(args: &LutOptions) -> Result<(usize, u32), Error> {
             format!("texels per side from 1 to {MAX_SIZE}"),
         ));
     }
-    if samples == 0 || samples > MAX_SAMPLES {
+    if let Some(samples) = args.samples.filter(|&n| n == 0 || n > MAX_SAMPLES) {
         return Err(Error::input(
             Field::Samples,
             samples,
             format!("samples per texel from 1 to {MAX_SAMPLES}"),
         ));
     }
-    if args.kind == Kind::Coat && size > coat::MAX_SIZE {
+    if let Some(limit) = &facts.size_limit
+        && !(limit.min..=limit.max).contains(&size)
+    {
         return Err(Error::input(
             Field::Size,
             size,
             Hint::new(
                 format!(
-                    "texels per slice side from 1 to {} for {{}} coat (its atlas is {} slices wide)",
-                    coat::MAX_SIZE,
-                    crate::measure::coat::SLICES
+                    "texels per slice side from {} to {} for {{}} {} ({})",
+                    limit.min,
+                    limit.max,
+                    facts.key,
+                    (limit.why)()
                 ),
                 [Field::Kind],
             ),
         ));
     }
-    if args.kind == Kind::Glass && size > glass::MAX_SIZE {
-        return Err(Error::input(
-            Field::Size,
-            size,
-            Hint::new(
-                format!(
-                    "texels per slice side from 1 to {} for {{}} glass (its atlas is {} slices wide and two high)",
-                    glass::MAX_SIZE,
-                    crate::measure::coat::SLICES
-                ),
-                [Field::Kind],
-            ),
-        ));
-    }
-    if args.kind == Kind::Anisotropic && !(2..=anisotropic::MAX_SIZE).contains(&size) {
-        return Err(Error::input(
-            Field::Size,
-            size,
-            Hint::new(
-                format!(
-                    "texels per slice side from 2 to {} for {{}} anisotropic (its atlas holds {} × size slices of size² albedos, each a 9,216-point quadrature)",
-                    anisotropic::MAX_SIZE,
-                    anisotropic::AZIMUTHS
-                ),
-                [Field::Kind],
-            ),
-        ));
-    }
-    Ok((size as usize, samples))
+    Ok(size as usize)
 }
 
-/// The split-sum table: GGX, no Blender version, and samples only for the classic method.
-fn split_sum_spec(args: &LutOptions, size: usize, samples: u32) -> Result<Spec, Error> {
-    if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
-        return Err(Error::input(
-            Field::Distribution,
-            d.key(),
-            Hint::new(
-                "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
-                [Field::Kind],
-            ),
-        ));
-    }
-    if let Some(v) = args.blender_version {
-        return Err(Error::input(
-            Field::BlenderVersion,
-            v,
-            Hint::new(
-                "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
-                [Field::Kind, Field::GModel, Field::BlenderVersion],
-            ),
-        ));
-    }
-    let estimate = match args.method.unwrap_or(Method::Quadrature) {
-        Method::Quadrature => {
-            if let Some(n) = args.samples {
-                return Err(Error::input(
-                    Field::Samples,
-                    n,
-                    Hint::new(
-                        "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
-                        [Field::Kind, Field::Method, Field::Samples, Field::Method],
-                    ),
-                ));
-            }
-            split_sum::Estimate::Quadrature(split_sum::Rule::default())
-        }
-        Method::Classic => split_sum::Estimate::Classic { samples },
-    };
-    Ok(Spec::SplitSum {
-        size,
-        g_model: args.g_model.unwrap_or(GModel::Ue4),
-        estimate,
-    })
-}
-
-/// The Blender tables (kulla-conty, albedo, coat) take their masking from the Blender
-/// version: `--g-model` and `--method` belong to split-sum.
+/// The Blender tables take their masking from the Blender version: `--g-model` and `--method` belong to split-sum.
 fn reject_split_sum_flags(args: &LutOptions) -> Result<(), Error> {
     let kind = args.kind.key();
     if let Some(g) = args.g_model {
@@ -621,7 +454,7 @@ fn reject_split_sum_flags(args: &LutOptions) -> Result<(), Error> {
     Ok(())
 }
 
-/// Albedo and coat are integrated by quadrature: no samples.
+/// The tables integrated by quadrature take no samples.
 fn reject_samples(args: &LutOptions) -> Result<(), Error> {
     match args.samples {
         Some(n) => Err(Error::input(
@@ -709,6 +542,7 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
     })?;
     write_output(&args.out, &bytes)?;
     let settings = Settings::of(&spec);
+    let facts = args.kind.facts();
     Ok(LutSummary {
         path: args.out.clone(),
         kind: args.kind,
@@ -717,18 +551,14 @@ pub fn lut(args: &LutOptions, progress: &dyn Progress) -> Result<LutSummary, Err
         bits: args.bits,
         width: table.width,
         height: table.height,
-        channels: spec
-            .channel_meanings()
-            .iter()
-            .map(|c| c.to_string())
-            .collect(),
+        channels: facts.channels.iter().map(|c| c.to_string()).collect(),
         samples: settings.samples,
         g_model: settings.g_model,
         method: settings.method,
         distribution: settings.distribution,
         blender_version: settings.blender_version,
-        ior: matches!(spec, Spec::Coat { .. } | Spec::Glass { .. }).then(coat::ior),
-        azimuths: matches!(spec, Spec::Anisotropic { .. }).then(anisotropic::azimuths),
+        ior: facts.slice_iors.map(|iors| iors()),
+        azimuths: facts.slice_azimuths.map(|azimuths| azimuths()),
         bytes: bytes.len(),
         compute_seconds,
         seconds: start.elapsed().as_secs_f64(),
@@ -763,10 +593,8 @@ struct Settings {
 
 impl Settings {
     fn of(spec: &Spec) -> Self {
-        match *spec {
-            Spec::SplitSum {
-                g_model, estimate, ..
-            } => {
+        match spec.bsdf {
+            Bsdf::SplitSum { g_model, estimate } => {
                 let (samples, method) = match estimate {
                     split_sum::Estimate::Classic { samples } => (Some(samples), Method::Classic),
                     split_sum::Estimate::Quadrature(_) => (None, Method::Quadrature),
@@ -779,71 +607,17 @@ impl Settings {
                     blender_version: None,
                 }
             }
-            Spec::KullaConty {
+            Bsdf::Blender(BlenderBsdf {
+                distribution,
+                blender_version,
                 samples,
-                distribution,
-                blender_version,
-                ..
-            } => Settings {
-                samples: Some(samples),
-                ..Settings::blender(distribution, blender_version)
+            }) => Settings {
+                samples,
+                g_model: None,
+                method: None,
+                distribution: Some(distribution),
+                blender_version: Some(blender_version.to_string()),
             },
-            Spec::Albedo {
-                distribution,
-                blender_version,
-                ..
-            }
-            | Spec::Coat {
-                distribution,
-                blender_version,
-                ..
-            }
-            | Spec::Anisotropic {
-                distribution,
-                blender_version,
-                ..
-            }
-            | Spec::Glass {
-                distribution,
-                blender_version,
-                ..
-            } => Settings::blender(distribution, blender_version),
-        }
-    }
-
-    /// A table of Blender's own distribution and masking, not sampled.
-    fn blender(distribution: Distribution, blender_version: BlenderVersion) -> Self {
-        Settings {
-            samples: None,
-            g_model: None,
-            method: None,
-            distribution: Some(distribution),
-            blender_version: Some(blender_version.to_string()),
-        }
-    }
-}
-
-impl Spec {
-    /// What each stored channel holds, in order.
-    fn channel_meanings(&self) -> &'static [&'static str] {
-        match self {
-            Spec::SplitSum { .. } => &["R: scale", "G: bias"],
-            Spec::KullaConty { .. } => &[
-                "R: scale",
-                "G: bias",
-                "B: integral of f_ms cos (≈ 1 − E)",
-                "A: E_avg(r)",
-            ],
-            Spec::Coat { .. } => &["R: A(μ, r, IOR of the slice)", "G: E(μ, r)"],
-            Spec::Albedo { .. } => &["R: E(μ, r)", "G: E_avg(r)"],
-            Spec::Anisotropic { .. } => &[
-                "R: E(N·V, φ of the slice's column, αx = rx², αy = ry² of the slice's row)",
-                "G: E_avg(αx, αy)",
-            ],
-            Spec::Glass { .. } => &[
-                "R: E(μ, r, η) of the Glass BSDF, η = IOR of the slice (top row) or 1/IOR (bottom row)",
-                "G: E(μ, r, η) of the Refraction BSDF",
-            ],
         }
     }
 }

@@ -1,6 +1,9 @@
 //! The split-sum LUT (Karis 2013, "Real Shading in Unreal Engine 4"; the classic "BRDF
 //! generator"; `docs/PHYSICS.md` §10): deterministic quadrature, vectorised.
 //!
+//! An n × n table of two channels, **R = scale, G = bias**, in the layout of every
+//! whole-table kind ([`super`]); at run time `specular = F0 · scale + bias`.
+//!
 //! # The integral
 //!
 //! For texel (x, y) of an n × n table, at pixel centres: roughness `r = (x + ½)/n`,
@@ -61,10 +64,86 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::GModel;
+use super::{Bsdf, GModel, KindFacts, LutOptions, Method, Spec, Table};
+use crate::error::{Error, Field, Hint};
 use crate::measure::albedo::gauss_unit;
 use crate::measure::{Distribution, Masking, Microfacet};
 use crate::progress::Progress;
+
+/// The split-sum table: its facts for `lut` (see the module's doc for its layout).
+pub const KIND: KindFacts = KindFacts {
+    key: "split-sum",
+    default_size: 512,
+    size_limit: None,
+    bsdf,
+    channels: &["R: scale", "G: bias"],
+    steps_per_size: 1,
+    slice_iors: None,
+    slice_azimuths: None,
+    compute: table,
+};
+
+/// Hammersley samples per texel of the classic estimator when none are asked for.
+const CLASSIC_SAMPLES: u32 = 2048;
+
+/// The split-sum table: GGX, no Blender version, and samples only for the classic method.
+fn bsdf(args: &LutOptions) -> Result<Bsdf, Error> {
+    if let Some(d) = args.distribution.filter(|&d| d != Distribution::Ggx) {
+        return Err(Error::input(
+            Field::Distribution,
+            d.key(),
+            Hint::new(
+                "ggx or nothing: the split-sum table is GGX by definition (use {} kulla-conty for Cycles' Beckmann or Ashikhmin-Shirley)",
+                [Field::Kind],
+            ),
+        ));
+    }
+    if let Some(v) = args.blender_version {
+        return Err(Error::input(
+            Field::BlenderVersion,
+            v,
+            Hint::new(
+                "nothing with {} split-sum (choose its masking with {}; {} applies to kulla-conty)",
+                [Field::Kind, Field::GModel, Field::BlenderVersion],
+            ),
+        ));
+    }
+    let estimate = match args.method.unwrap_or(Method::Quadrature) {
+        Method::Quadrature => {
+            if let Some(n) = args.samples {
+                return Err(Error::input(
+                    Field::Samples,
+                    n,
+                    Hint::new(
+                        "nothing with {} split-sum's default {} quadrature (it is deterministic quadrature, not sampled; {} applies to {} classic)",
+                        [Field::Kind, Field::Method, Field::Samples, Field::Method],
+                    ),
+                ));
+            }
+            Estimate::Quadrature(Rule::default())
+        }
+        Method::Classic => Estimate::Classic {
+            samples: args.samples.unwrap_or(CLASSIC_SAMPLES),
+        },
+    };
+    Ok(Bsdf::SplitSum {
+        g_model: args.g_model.unwrap_or(GModel::Ue4),
+        estimate,
+    })
+}
+
+/// The two-channel table of a split-sum request.
+fn table(spec: &Spec, progress: &dyn Progress) -> Table {
+    let Bsdf::SplitSum { g_model, estimate } = spec.bsdf else {
+        unreachable!("only split-sum's own request is its GGX");
+    };
+    Table {
+        width: spec.size,
+        height: spec.size,
+        channels: &["R", "G"],
+        data: split_sum(spec.size, g_model, estimate, progress),
+    }
+}
 
 /// Lanes of the inner kernels (one AVX register of f32).
 const LANES: usize = 8;

@@ -21,7 +21,7 @@ pub use verdict::{Judging, Note, ReferenceSphere, Row, Sweep, VerifyReport, Wors
 use crate::blender::{Blender, BlenderOptions};
 use crate::error::{Error, Field, Hint};
 use crate::fit::Coefficients;
-use crate::generate::params::GlassTable;
+use crate::generate::tables::GlassTable;
 use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Anisotropy, BlenderVersion, Distribution, Engine, Roughness, coat};
 use crate::progress::Progress;
