@@ -245,13 +245,13 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             let verification = gloffuse::verify::verify(&v.options(), &terminal)?;
             let rerun = this_command();
             if let Some(dir) = &v.report {
-                for p in gloffuse::report::write_files(dir, &verification, &rerun)? {
+                for p in gloffuse::report::verify::write_files(dir, &verification, &rerun)? {
                     eprintln_quietly(&format!("wrote {}", p.display()));
                 }
             }
             let report = &verification.report;
             if let Some(path) = &v.junit {
-                let xml = gloffuse::report::junit::render(report, &rerun);
+                let xml = gloffuse::report::verify::junit::render(report, &rerun);
                 write_output(path, xml.as_bytes())?;
                 eprintln_quietly(&format!("wrote {}", path.display()));
             }

@@ -8,7 +8,7 @@ pub mod table;
 
 use std::path::{Path, PathBuf};
 
-use super::deviation::colour;
+use super::false_colour::colour;
 use super::png::{cell_image, encode_png};
 use crate::Error;
 use crate::audit::{AuditReport, FileDone};
