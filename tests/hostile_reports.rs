@@ -303,7 +303,7 @@ fn counts_of_one_read_singular_and_the_verdict_stands_out() {
         return;
     };
     let image = common::screenshot(&chromium, &page);
-    let banner = common::pixels_of(&image, gloffuse::report::html::FAIL_COLOUR);
+    let banner = common::pixels_of(&image, gloffuse::report::page::FAIL_COLOUR);
     assert!(banner > 10_000, "{banner} pixels of the FAIL banner");
 }
 

@@ -8,7 +8,8 @@
 use std::path::{Path, PathBuf};
 
 use gloffuse::measure::{Distribution, Roughness};
-use gloffuse::report::png::{PLOT_SIZE, brightness_plot, contact_sheet, sheet_labels};
+use gloffuse::report::verify::plot::{PLOT_SIZE, brightness_plot};
+use gloffuse::report::verify::sheet::{contact_sheet, sheet_labels};
 use gloffuse::verify::image::Rgba;
 use gloffuse::verify::plan::{Plan, RenderSettings};
 use gloffuse::verify::stats::{RINGS, SphereStats, sphere_stats};

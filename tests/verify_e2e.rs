@@ -382,7 +382,7 @@ fn junit_and_html_reports_of_a_failing_check() {
         return;
     };
     let image = common::screenshot(&chromium, &page);
-    let banner_pixels = common::pixels_of(&image, gloffuse::report::html::FAIL_COLOUR);
+    let banner_pixels = common::pixels_of(&image, gloffuse::report::page::FAIL_COLOUR);
     assert!(
         banner_pixels > 10_000,
         "{banner_pixels} pixels of the FAIL banner"

@@ -245,13 +245,13 @@ fn run(cli: Cli, out: &mut dyn Write) -> Result<Outcome> {
             let verification = gloffuse::verify::verify(&v.options(), &terminal)?;
             let rerun = this_command();
             if let Some(dir) = &v.report {
-                for p in gloffuse::report::write_files(dir, &verification, &rerun)? {
+                for p in gloffuse::report::verify::write_files(dir, &verification, &rerun)? {
                     eprintln_quietly(&format!("wrote {}", p.display()));
                 }
             }
             let report = &verification.report;
             if let Some(path) = &v.junit {
-                let xml = gloffuse::report::junit::render(report, &rerun);
+                let xml = gloffuse::report::verify::junit::render(report, &rerun);
                 write_output(path, xml.as_bytes())?;
                 eprintln_quietly(&format!("wrote {}", path.display()));
             }
@@ -373,8 +373,7 @@ fn write_audit_junit(path: Option<&Path>, report: &AuditReport, rerun: &str) -> 
 
 /// `report merge`: the shards read and checked, then the outputs of one unsharded audit.
 fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<Outcome> {
-    use gloffuse::audit::merge::{merge, read_report, report_json};
-    use gloffuse::report::audit::{ReportDir, ShardPicture, ShardPictures};
+    use gloffuse::report::audit::merge::{Skipped, copy_pictures};
     if let Some(dir) = &m.report {
         gloffuse::report::check_dir(dir)?;
     }
@@ -383,54 +382,23 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     }
     // As in `audit`: a stop removes the staging folder instead of ending the process in it.
     let _hold = cancel().hold();
-    let shards = m
-        .shards
-        .iter()
-        .map(|p| Ok((p.clone(), read_report(p)?)))
-        .collect::<Result<Vec<_>>>()?;
-    let merged = merge(shards)?;
+    let merged = gloffuse::audit::merge::merge(&m.shards)?;
     let report = &merged.report;
     let rerun = this_command();
     if let Some(dir) = &m.report {
-        let mut folder = ReportDir::create(dir)?;
-        let mut unpictured = std::collections::BTreeSet::new();
-        // Each shard's folder: the one holding its report.json.
-        // Each shard's pictures, in the folder holding its report.json (none from a shard
-        // whose materials/ is refused).
-        let pictures: Vec<Option<ShardPictures>> = (merged.shards.iter())
-            .map(|s| {
-                let json = report_json(s);
-                ShardPictures::open(json.parent().unwrap_or(Path::new(".")))
-                    .map_err(|link| refused_picture(&link))
-                    .ok()
-            })
-            .collect();
-        for (&(k, i), material) in merged.sources.iter().zip(&report.materials) {
-            cancel().check()?;
-            let Some(shard) = &pictures[k] else {
-                folder.add_copy(None)?;
-                continue;
-            };
-            let copy = match shard.picture(i) {
-                ShardPicture::File(path, file) => Some((path, file)),
-                ShardPicture::Missing => {
-                    if material.mean.is_some() {
-                        unpictured.insert(k + 1);
-                    }
-                    None
-                }
-                ShardPicture::Refused(path) => {
-                    refused_picture(&path);
-                    None
-                }
-            };
-            folder.add_copy(copy)?;
-        }
-        for k in unpictured {
-            eprintln_quietly(&format!(
-                "note: shard {k} has no pictures beside its report.json (run the shards with \
-                 --report DIR to have them in the merged report)"
-            ));
+        let (folder, skipped) = copy_pictures(dir, &merged, cancel())?;
+        for s in skipped {
+            eprintln_quietly(&match s {
+                Skipped::NotRegular(path) => format!(
+                    "note: skipped {}: a symbolic link or not a regular file (a merge copies \
+                     only a shard's own pictures, never what a link points to)",
+                    path.display()
+                ),
+                Skipped::NoPictures(k) => format!(
+                    "note: shard {k} has no pictures beside its report.json (run the shards \
+                     with --report DIR to have them in the merged report)"
+                ),
+            });
         }
         cancel().check()?;
         for p in folder.finish(report, &rerun)? {
@@ -450,15 +418,6 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         out.write_all(gloffuse::report::audit::table::render(report).as_bytes())?;
     }
     Ok(verdict(report.passed || m.exit_zero))
-}
-
-/// The note for a shard's picture (or `materials/`) left out of a merged report.
-fn refused_picture(path: &Path) {
-    eprintln_quietly(&format!(
-        "note: skipped {}: a symbolic link or not a regular file (a merge copies only a shard's \
-         own pictures, never what a link points to)",
-        path.display()
-    ));
 }
 
 /// The command line this process was started with, quoted for a shell: how to rerun it.

@@ -1,5 +1,5 @@
 //! What the commands print as text: every rendering for a person, in one file. (The verify
-//! table is a renderer of the verdict and lives with the others in `gloffuse::report`.)
+//! table is a renderer of the verdict and lives with the others in `gloffuse::report::verify`.)
 
 use std::fmt::Write as _;
 
@@ -56,7 +56,7 @@ pub fn generated(out: &Generated) -> String {
 /// The verify table, then the flag for each preset a note suggests (the library's notes
 /// name presets; only the command line knows its flags).
 pub fn verify(report: &VerifyReport) -> String {
-    let mut s = gloffuse::report::table::render(report);
+    let mut s = gloffuse::report::verify::table::render(report);
     let mut presets: Vec<&str> = report
         .notes
         .iter()

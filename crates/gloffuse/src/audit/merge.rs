@@ -32,7 +32,7 @@ pub fn report_json(path: &Path) -> PathBuf {
 }
 
 /// Reads the audit report at `path` (a report.json, or the folder holding one).
-pub fn read_report(path: &Path) -> Result<AuditReport, Error> {
+fn read_report(path: &Path) -> Result<AuditReport, Error> {
     let json = report_json(path);
     let text = read_regular(&json)?;
     serde_json::from_str(&text).map_err(|e| {
@@ -80,14 +80,17 @@ fn read_regular(path: &Path) -> Result<String, Error> {
     Ok(text)
 }
 
-/// Merges every shard of one run, given in any order.
-pub fn merge(shards: Vec<(PathBuf, AuditReport)>) -> Result<Merged, Error> {
-    let ordered = in_order(
-        shards
-            .into_iter()
-            .map(|(path, r)| (path, r.shard.as_ref().map(|s| s.shard), r))
-            .collect(),
-    )?;
+/// Reads and merges every shard of one run, given in any order (each a report.json or the
+/// folder holding one).
+pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
+    let shards = paths
+        .iter()
+        .map(|path| {
+            let r = read_report(path)?;
+            Ok((path.clone(), r.shard.as_ref().map(|s| s.shard), r))
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
+    let ordered = in_order(shards)?;
     let (first_path, first) = &ordered[0];
     for (path, r) in &ordered[1..] {
         if let Some(what) = difference(first, r) {

@@ -1,73 +1,23 @@
-//! ⑤ Report: renderers of the verify verdict, one file each — `table` (terminal), `json`
-//! (machines), `junit` (CI servers), `html` (a page for people), `png` (the contact sheet
-//! and the brightness plot), `deviation` (the false-colour view), `notes` (the verdict's
-//! notes in words), `words` (the verdict and the mode in words), `escape` (users' names made
-//! safe for a terminal and for XML) — and the report folder that holds them with the rendered EXR.
+//! ⑤ Report: renderers of the verdicts, verify's in `verify` and the audit's in `audit`,
+//! each with its report folder; and what both share: `png` (PNG helpers: the grey
+//! background, the font, atomic writes), `false_colour` (the diverging scale), `page` (a
+//! report page's style and banner, HTML escaping), `escape` (users' names made safe for a
+//! terminal and for XML).
 
 pub mod audit;
-pub mod deviation;
 pub mod escape;
-pub mod html;
-pub mod json;
-pub mod junit;
-pub mod notes;
+pub mod false_colour;
+pub mod page;
 pub mod png;
-pub mod table;
-pub mod words;
+pub mod verify;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::Error;
-use crate::output::{self, write_output};
-use crate::verify::Verification;
+use crate::output;
 
 /// Checks that `dir` can become a report folder: it is made if missing, but its parent
 /// must exist. Called before any slow work.
 pub fn check_dir(dir: &Path) -> Result<(), Error> {
     output::report_dir(dir)
-}
-
-/// Writes report.json, sweep.exr, contact-sheet.png, brightness.png, deviation.png and
-/// report.html into `dir` (made if missing; its parent must exist); returns the paths
-/// written. `rerun` is the command line of the check, for the page.
-pub fn write_files(
-    dir: &Path,
-    verification: &Verification,
-    rerun: &str,
-) -> Result<Vec<PathBuf>, Error> {
-    let Verification { report, rendered } = verification;
-    output::make_report_dir(dir)?;
-    let json_path = dir.join("report.json");
-    write_output(&json_path, json::render(report).as_bytes())?;
-    let exr_path = dir.join("sweep.exr");
-    let bytes = std::fs::read(&rendered.exr).map_err(|source| Error::Read {
-        path: rendered.exr.clone(),
-        source,
-    })?;
-    write_output(&exr_path, &bytes)?;
-    let sheet = dir.join("contact-sheet.png");
-    let (rows, columns) = png::sheet_labels(&rendered.plan, report.mode);
-    png::contact_sheet(
-        &rendered.image,
-        rendered.plan.settings.cell as usize,
-        &rows,
-        &columns,
-        &sheet,
-    )?;
-    let plot = dir.join(html::PLOT);
-    png::brightness_plot(report, &plot)?;
-    let false_colour = dir.join("deviation.png");
-    deviation::sheet(report, rendered, &false_colour)?;
-    let mut written = vec![json_path, exr_path, sheet, plot, false_colour];
-    let names: Vec<String> = written
-        .iter()
-        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect();
-    let page = dir.join("report.html");
-    write_output(
-        &page,
-        html::render(report, rendered, rerun, &names).as_bytes(),
-    )?;
-    written.push(page);
-    Ok(written)
 }

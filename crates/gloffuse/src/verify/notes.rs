@@ -1,5 +1,5 @@
 //! Which notes a verdict carries: each a check of the sweep and its outcome that returns a
-//! [`Note`] (data; `crate::report::notes` words it).
+//! [`Note`] (data; `crate::report::verify::notes` words it).
 
 use super::verdict::{Note, Row, Sweep, WorstSphere};
 use crate::fit::{ColorSpace, preset_for};

@@ -176,7 +176,7 @@ pub struct VerifyReport {
     pub rows: Vec<Row>,
     pub reference: Vec<ReferenceSphere>,
     /// Explanations for the reader (display-referred coefficients, masking mismatch, …), as
-    /// data: `crate::report::notes` puts them into words.
+    /// data: `crate::report::verify::notes` puts them into words.
     pub notes: Vec<Note>,
     pub pass: bool,
 }

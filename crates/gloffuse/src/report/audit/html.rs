@@ -5,7 +5,7 @@
 use super::table::{counts, file_findings, older_blender, order, pct};
 use crate::audit::{AuditReport, AuditedMaterial};
 use crate::plural::count;
-use crate::report::html::{banner, escape, page_css};
+use crate::report::page::{banner, escape, page_css};
 
 /// `pictures[i]` is material i's picture (report order), relative to the page.
 pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) -> String {

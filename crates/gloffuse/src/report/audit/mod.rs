@@ -1,14 +1,16 @@
 //! Renderers of the audit's verdict: `table` (terminal), `junit` (CI servers), `html` (a
 //! page for people, each material as authored beside its twin and their difference), and
-//! the report folder, whose pictures are made file by file while the audit streams.
+//! the report folder, whose pictures are made file by file while the audit streams, or
+//! copied from the shards' folders by `merge`.
 
 pub mod html;
 pub mod junit;
+pub mod merge;
 pub mod table;
 
 use std::path::{Path, PathBuf};
 
-use super::deviation::colour;
+use super::false_colour::colour;
 use super::png::{cell_image, encode_png};
 use crate::Error;
 use crate::audit::{AuditReport, FileDone};
@@ -86,8 +88,8 @@ impl ReportDir {
     }
 
     /// Adds the next material's picture as a copy of `from` (a shard's picture, opened by
-    /// [`ShardPictures::picture`]), if any.
-    pub fn add_copy(&mut self, from: Option<(PathBuf, std::fs::File)>) -> Result<(), Error> {
+    /// [`merge::ShardPictures::picture`]), if any.
+    fn add_copy(&mut self, from: Option<(PathBuf, std::fs::File)>) -> Result<(), Error> {
         let picture = match from {
             Some((from, mut source)) => {
                 let file = picture_name(self.pictures.len());
@@ -145,84 +147,6 @@ impl Drop for ReportDir {
             if self.made {
                 let _ = std::fs::remove_dir(&self.dir);
             }
-        }
-    }
-}
-
-/// A shard's pictures, as `report merge` copies them: only regular files in a `materials/`
-/// that is a folder, neither being a symbolic link. A shard's folder is on storage others
-/// can write, and a link there would have the merge publish whatever file it points to.
-/// The folder is opened once and each picture opened inside it without following links,
-/// so a link put in place after the checks is refused as well.
-pub struct ShardPictures {
-    folder: PathBuf,
-    dir: Option<std::fs::File>,
-}
-
-/// A shard's picture of one material.
-pub enum ShardPicture {
-    /// A regular file, open to copy; its path.
-    File(PathBuf, std::fs::File),
-    /// None: the material was not rendered, or its shard ran without `--report`.
-    Missing,
-    /// A symbolic link or another file that is not a regular one (a FIFO, a device): not
-    /// copied.
-    Refused(PathBuf),
-}
-
-impl ShardPictures {
-    /// The pictures of the shard whose report is in `dir`; `Err` names its `materials/` if
-    /// that is a symbolic link or no folder.
-    pub fn open(dir: &Path) -> Result<Self, PathBuf> {
-        use std::os::unix::fs::OpenOptionsExt;
-        let folder = dir.join(PICTURES);
-        let meta = match std::fs::symlink_metadata(&folder) {
-            Ok(meta) => meta,
-            Err(_) => return Ok(ShardPictures { folder, dir: None }),
-        };
-        if !meta.is_dir() {
-            return Err(folder);
-        }
-        let dir = std::fs::OpenOptions::new()
-            .read(true)
-            .custom_flags(libc::O_DIRECTORY | libc::O_NOFOLLOW)
-            .open(&folder)
-            .map_err(|_| folder.clone())?;
-        Ok(ShardPictures {
-            folder,
-            dir: Some(dir),
-        })
-    }
-
-    /// The picture of the material at `index` of the shard's report.
-    pub fn picture(&self, index: usize) -> ShardPicture {
-        use std::os::fd::{AsRawFd, FromRawFd};
-        let Some(dir) = &self.dir else {
-            return ShardPicture::Missing;
-        };
-        let name = picture_name(index);
-        let path = self.folder.join(&name);
-        let c_name = std::ffi::CString::new(name).expect("a picture's name has no NUL");
-        // SAFETY: `dir` is an open folder and `c_name` a NUL-terminated name; a descriptor
-        // returned is owned by the File made of it alone.
-        let fd = unsafe {
-            libc::openat(
-                dir.as_raw_fd(),
-                c_name.as_ptr(),
-                libc::O_RDONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_CLOEXEC,
-            )
-        };
-        if fd < 0 {
-            return match std::io::Error::last_os_error().raw_os_error() {
-                Some(libc::ENOENT) => ShardPicture::Missing,
-                _ => ShardPicture::Refused(path),
-            };
-        }
-        // SAFETY: `fd` was just opened and is owned by nothing else.
-        let file = unsafe { std::fs::File::from_raw_fd(fd) };
-        match file.metadata() {
-            Ok(meta) if meta.is_file() => ShardPicture::File(path, file),
-            _ => ShardPicture::Refused(path),
         }
     }
 }

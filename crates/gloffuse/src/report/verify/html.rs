@@ -6,33 +6,11 @@
 
 use std::fmt::Write as _;
 
-use super::{deviation, png, words};
+use super::{deviation, words};
+use crate::report::page::{FAIL_COLOUR, PASS_COLOUR, banner, escape, page_css};
+use crate::report::{false_colour, png};
 use crate::verify::verdict::MIN_RING_PIXELS;
 use crate::verify::{Rendered, Row, VerifyReport, reference_label};
-
-/// The colours of the verdict banner (the browser test looks for them).
-pub const PASS_COLOUR: &str = "#1b7a2f";
-pub const FAIL_COLOUR: &str = "#b3261e";
-
-/// The style every report page starts with (verify's, audit's): the page, and its banner
-/// in the verdict's colour.
-pub(crate) fn page_css(pass: bool) -> String {
-    let banner = if pass { PASS_COLOUR } else { FAIL_COLOUR };
-    format!(
-        "body {{ font: 14px/1.4 sans-serif; margin: 0; color: #222; background: #fafafa; }}\n\
-         header {{ background: {banner}; color: white; padding: 16px 24px; }}\n\
-         header h1 {{ margin: 0 0 4px; font-size: 22px; }}\n\
-         main {{ padding: 8px 24px 32px; }}\n"
-    )
-}
-
-/// The banner: `title` (text) over `detail` (HTML); it opens `<main>`.
-pub(crate) fn banner(title: &str, detail: &str) -> String {
-    format!(
-        "<header><h1>{}</h1><div>{detail}</div></header><main>\n",
-        escape(title)
-    )
-}
 
 /// `rerun` is the command line that reproduces the whole check (the CLI passes its own);
 /// `files` are the report's other files, linked by name.
@@ -72,9 +50,9 @@ fn write_head(s: &mut String, verdict: &str, pass: bool) {
          .scale {{ width: 100%; height: 14px; background: linear-gradient(to right, {}, {}, {}); }}\n\
          </style></head><body>\n",
         page_css(pass),
-        css(deviation::colour(-deviation::SCALE)),
-        css(deviation::colour(0.0)),
-        css(deviation::colour(deviation::SCALE)),
+        css(false_colour::colour(-false_colour::SCALE)),
+        css(false_colour::colour(0.0)),
+        css(false_colour::colour(false_colour::SCALE)),
     );
 }
 
@@ -238,7 +216,7 @@ fn write_scale(s: &mut String) {
         "<div class=\"legend\"><div class=\"caption\">Deviation column: each pixel of the corrected sphere against its target</div>\
          <div class=\"scale\"></div><div class=\"ticks\"><span>−{0} % (darker)</span><span>0</span>\
          <span>+{0} % (brighter)</span></div></div>",
-        100.0 * deviation::SCALE
+        100.0 * false_colour::SCALE
     );
 }
 
@@ -301,14 +279,6 @@ fn png_tag(rgb: &[u8], cell: usize) -> String {
     }
 }
 
-/// Text for HTML: `&`, `<`, `>` and `"` escaped.
-pub(crate) fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 /// Standard base64 with padding (RFC 4648).
 fn base64(bytes: &[u8]) -> String {
     const TABLE: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -348,9 +318,5 @@ mod tests {
         ] {
             assert_eq!(base64(text.as_bytes()), encoded);
         }
-        assert_eq!(
-            escape("<a href=\"x\">&</a>"),
-            "&lt;a href=&quot;x&quot;&gt;&amp;&lt;/a&gt;"
-        );
     }
 }
