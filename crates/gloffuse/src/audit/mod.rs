@@ -23,6 +23,7 @@ pub use verdict::{
 
 use std::path::{Path, PathBuf};
 
+use crate::blend_file::read_header;
 use crate::blend_file::{MATERIAL, count_blocks};
 use crate::blender::{Blender, BlenderOptions, find_for_files};
 use crate::file_lock::Wait;
@@ -31,7 +32,6 @@ use crate::output::check_destination;
 use crate::plural::count;
 use crate::progress::Progress;
 use crate::shard::Shard;
-use crate::user_blend::read_header;
 use crate::verify::RenderSettings;
 use crate::verify::image::{Rgba, read_rgba};
 use crate::{Error, Field, Hint};
