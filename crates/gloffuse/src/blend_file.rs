@@ -1,13 +1,18 @@
-//! What gloffuse reads of a .blend without Blender: how many ID blocks of one kind it holds
-//! (`audit` counts materials before any Blender starts, for its progress and cost).
+//! The one place gloffuse reads a .blend's bytes without Blender: its header (the Blender
+//! that saved it, its compression), whether it ends as a complete file does, and how many
+//! ID blocks of one kind it holds (`audit` counts materials before any Blender starts, for
+//! its progress and cost). `user_blend` (changing a user's file safely) builds on it.
 //!
-//! A .blend is a header, then blocks, each a block header and its bytes, up to `ENDB`.
-//! Three block-header layouts exist: 20 bytes (4-byte pointers, `BLENDER_v…`), 24 bytes
-//! (8-byte pointers, `BLENDER-v…`) and the 32-byte form of Blender 5.0's 17-byte header
-//! (`BLENDER17-01v0500`, format 01: code, SDNA index, old pointer, then a 64-bit length).
-//! Every ID block's header carries the ID's two-letter code (`MA\0\0` for a material).
-//! A compressed .blend (3.0+) is a zstd stream of many frames (Blender writes one per
-//! 256 KiB) and a skippable frame holding their seek table: every frame is read.
+//! A .blend is a header, then blocks, each a block header and its bytes, up to `ENDB`. The
+//! header comes in two forms: 12 bytes, `BLENDER-v405` (pointer size `-` 8 bytes or `_` 4,
+//! endianness `v` little or `V` big, a 3-digit version), and the form Blender 5.0
+//! introduced, `BLENDER17-01v0500` (header size, pointer size, format version, endianness,
+//! a 4-digit version). Three block-header layouts follow from it: 20 bytes (4-byte
+//! pointers), 24 bytes (8-byte pointers) and the 32 bytes of format 01 (code, SDNA index,
+//! old pointer, then a 64-bit length). Every ID block's header carries the ID's two-letter
+//! code (`MA\0\0` for a material). A compressed .blend is gzip (before 3.0) or, from 3.0, a
+//! zstd stream of many frames (Blender writes one per 256 KiB) ending in a skippable frame
+//! holding their seek table: the count reads every frame.
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
@@ -15,12 +20,37 @@ use std::path::Path;
 use ruzstd::decoding::errors::{FrameDecoderError, ReadFrameHeaderError};
 use ruzstd::decoding::{BlockDecodingStrategy, FrameDecoder};
 
-use crate::user_blend::read_up_to;
+use crate::measure::BlenderVersion;
 
 /// The ID code of a material block.
 pub const MATERIAL: [u8; 4] = *b"MA\0\0";
 
+/// The zstd frame magic, the gzip magic.
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// The magic that ends Zstandard's seekable format, which Blender's compressed .blend
+/// files end with (its seek table, little-endian 0x8F92EAB1).
+const SEEKABLE_FOOTER: [u8; 4] = [0xb1, 0xea, 0x92, 0x8f];
+
+/// How a .blend's bytes are stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compression {
+    None,
+    /// Zstandard: Blender 3.0 and later.
+    Zstd,
+    /// Gzip: Blender before 3.0.
+    Gzip,
+}
+
+/// What the first bytes of a .blend say.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlendHeader {
+    /// The Blender that saved it; `None` for a gzip file, which only Blender before 3.0
+    /// wrote (older than every Blender gloffuse runs).
+    pub version: Option<BlenderVersion>,
+    pub compression: Compression,
+}
 
 /// The layout of a file's block headers, read from its header.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,39 +61,122 @@ struct Layout {
     big_endian: bool,
 }
 
-/// The layout the first bytes `head` (at least 17, decompressed) announce.
-fn layout(head: &[u8]) -> Option<Layout> {
+/// What a .blend's first bytes announce: the Blender that saved it, and the layout of its
+/// block headers where gloffuse knows it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Start {
+    version: BlenderVersion,
+    layout: Option<Layout>,
+}
+
+/// The start of the .blend bytes `head` (the file's first 17 bytes, decompressed), if they
+/// are a .blend header of either form.
+fn parse_start(head: &[u8]) -> Option<Start> {
     let rest = head.strip_prefix(b"BLENDER")?;
-    let endian = |c: u8| match c {
-        b'v' => Some(false),
-        b'V' => Some(true),
+    let endian = |c: Option<&u8>| match c {
+        Some(b'v') => Some(false),
+        Some(b'V') => Some(true),
         _ => None,
     };
-    match *rest.first()? {
-        b'-' => Some(Layout {
-            header_len: 12,
-            bhead_len: 24,
-            big_endian: endian(*rest.get(1)?)?,
-        }),
-        b'_' => Some(Layout {
-            header_len: 12,
-            bhead_len: 20,
-            big_endian: endian(*rest.get(1)?)?,
-        }),
+    let (digits, layout) = match *rest.first()? {
+        pointer @ (b'-' | b'_') => {
+            let layout = endian(rest.get(1)).map(|big_endian| Layout {
+                header_len: 12,
+                bhead_len: if pointer == b'-' { 24 } else { 20 },
+                big_endian,
+            });
+            (rest.get(2..5)?, layout)
+        }
         b'0'..=b'9' => {
             let header_len: usize = std::str::from_utf8(rest.get(..2)?).ok()?.parse().ok()?;
+            // 7 (BLENDER) + 2 (size) + 1 (pointer) + 2 (format) + 1 (endianness) + digits.
+            let digits = rest.get(6..header_len.checked_sub(7)?)?;
             // Pointer size '-' (8 bytes), format "01" (the large block header), endianness.
-            if rest.get(2..5)? != b"-01" {
-                return None;
-            }
-            Some(Layout {
-                header_len,
-                bhead_len: 32,
-                big_endian: endian(*rest.get(5)?)?,
-            })
+            let layout = (rest.get(2..5) == Some(b"-01"))
+                .then(|| endian(rest.get(5)))
+                .flatten()
+                .map(|big_endian| Layout {
+                    header_len,
+                    bhead_len: 32,
+                    big_endian,
+                });
+            (digits, layout)
         }
-        _ => None,
+        _ => return None,
+    };
+    if !digits.iter().all(u8::is_ascii_digit) || digits.len() < 3 {
+        return None;
     }
+    let number: u32 = std::str::from_utf8(digits).ok()?.parse().ok()?;
+    let version = BlenderVersion {
+        major: number / 100,
+        minor: number % 100,
+    };
+    Some(Start { version, layout })
+}
+
+/// Reads the header of the .blend at `path` (decompressing the start of a zstd file).
+pub fn read_header(path: &Path) -> Result<BlendHeader, String> {
+    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+    let mut head = [0u8; 17];
+    let n = read_up_to(&mut file, &mut head).map_err(|e| format!("cannot be read ({e})"))?;
+    let head = &head[..n];
+    let not_blend = || "does not start with a .blend header".to_string();
+    if head.starts_with(&GZIP_MAGIC) {
+        return Ok(BlendHeader {
+            version: None,
+            compression: Compression::Gzip,
+        });
+    }
+    if head.starts_with(&ZSTD_MAGIC) {
+        let file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+        let mut decoder = ruzstd::decoding::StreamingDecoder::new(file)
+            .map_err(|e| format!("is compressed, but its zstd stream cannot be read ({e})"))?;
+        let mut inner = [0u8; 17];
+        let n = read_up_to(&mut decoder, &mut inner)
+            .map_err(|e| format!("is compressed, but its zstd stream cannot be read ({e})"))?;
+        let version = parse_start(&inner[..n]).ok_or_else(not_blend)?.version;
+        return Ok(BlendHeader {
+            version: Some(version),
+            compression: Compression::Zstd,
+        });
+    }
+    let version = parse_start(head).ok_or_else(not_blend)?.version;
+    Ok(BlendHeader {
+        version: Some(version),
+        compression: Compression::None,
+    })
+}
+
+/// Fills `buf` as far as the reader goes; returns how many bytes were read.
+fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match reader.read(&mut buf[filled..])? {
+            0 => break,
+            n => filled += n,
+        }
+    }
+    Ok(filled)
+}
+
+/// Whether the .blend at `path`, of header `header`, ends as a complete file does: an
+/// uncompressed one with the `ENDB` block in its last bytes, a zstd one with the seek table
+/// (a gzip one is taken as complete).
+pub fn ends_complete(path: &Path, header: &BlendHeader) -> bool {
+    use std::io::{Seek, SeekFrom};
+    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    let mut tail = vec![0u8; len.min(64) as usize];
+    let read = std::fs::File::open(path).and_then(|mut f| {
+        f.seek(SeekFrom::End(-(tail.len() as i64)))?;
+        f.read_exact(&mut tail)
+    });
+    read.is_ok()
+        && match header.compression {
+            Compression::None => tail.windows(4).any(|w| w == b"ENDB"),
+            Compression::Zstd => tail.ends_with(&SEEKABLE_FOOTER),
+            Compression::Gzip => true,
+        }
 }
 
 /// How many blocks with ID code `code` the .blend at `path` holds (plain or zstd); an
@@ -150,7 +263,9 @@ fn count_in(mut reader: impl Read, code: [u8; 4]) -> Result<usize, String> {
     let cut = || "ends before its last block".to_string();
     let mut head = [0u8; 17];
     let n = read_up_to(&mut reader, &mut head).map_err(|e| e.to_string())?;
-    let layout = layout(&head[..n]).ok_or("does not start with a .blend header")?;
+    let layout = parse_start(&head[..n])
+        .and_then(|start| start.layout)
+        .ok_or("does not start with a .blend header")?;
     // The header may be shorter than what was read: the rest starts the first block.
     let mut pending: Vec<u8> = head[layout.header_len.min(n)..n].to_vec();
     let mut count = 0;
@@ -203,6 +318,42 @@ fn block_len(bhead: &[u8], layout: Layout) -> u64 {
 mod tests {
     use super::*;
 
+    /// The version a header announces.
+    fn version(head: &[u8]) -> Option<BlenderVersion> {
+        parse_start(head).map(|start| start.version)
+    }
+
+    fn v(major: u32, minor: u32) -> Option<BlenderVersion> {
+        Some(BlenderVersion { major, minor })
+    }
+
+    #[test]
+    fn both_header_forms_give_the_version() {
+        // The first bytes of files saved by Blender 3.4.1, bpy 4.5 and bpy 5.0 (uncompressed).
+        assert_eq!(version(b"BLENDER-v304RENDH"), v(3, 4));
+        assert_eq!(version(b"BLENDER-v405RENDH"), v(4, 5));
+        assert_eq!(version(b"BLENDER_V279"), v(2, 79));
+        assert_eq!(version(b"BLENDER17-01v0500"), v(5, 0));
+        assert_eq!(version(b"BLENDER17-01v0502"), v(5, 2));
+        assert_eq!(version(b"BLENDER17-01v1203"), v(12, 3));
+    }
+
+    #[test]
+    fn what_is_not_a_header_gives_none() {
+        for bad in [
+            &b""[..],
+            b"BLENDER",
+            b"BLENDER-v4",
+            b"BLENDER-vabc",
+            b"BLENDEX-v405",
+            b"BLENDER17-01v05",
+            b"BLENDER03-01v0500",
+            b"PK\x03\x04",
+        ] {
+            assert_eq!(version(bad), None, "{:?}", String::from_utf8_lossy(bad));
+        }
+    }
+
     fn block(code: &[u8; 4], body: &[u8]) -> Vec<u8> {
         let mut b = code.to_vec();
         b.extend((body.len() as u32).to_le_bytes());
@@ -234,7 +385,7 @@ mod tests {
             bytes.extend(vec![9u8; len as usize]);
         }
         assert_eq!(count_in(bytes.as_slice(), MATERIAL), Ok(1));
-        assert!(layout(b"BLENDER17-02v0500").is_none());
+        assert_eq!(parse_start(b"BLENDER17-02v0500").unwrap().layout, None);
         assert!(count_in(&b"PK\x03\x04 not a blend at all"[..], MATERIAL).is_err());
     }
 

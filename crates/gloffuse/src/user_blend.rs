@@ -22,107 +22,14 @@
 //!    made since the command began (another gloffuse replaced the file while this one
 //!    waited) stays: it is what the user had before either run.
 
-use std::io::Read;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
+use crate::blend_file::{BlendHeader, Compression, read_header};
 use crate::file_lock::{FileLock, Wait};
 use crate::measure::BlenderVersion;
 use crate::{Error, Field, Hint};
-
-/// How a .blend's bytes are stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Compression {
-    None,
-    /// Zstandard: Blender 3.0 and later.
-    Zstd,
-    /// Gzip: Blender before 3.0.
-    Gzip,
-}
-
-/// What the first bytes of a .blend say.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BlendHeader {
-    /// The Blender that saved it; `None` for a gzip file, which only Blender before 3.0
-    /// wrote (older than every Blender gloffuse runs).
-    pub version: Option<BlenderVersion>,
-    pub compression: Compression,
-}
-
-/// The zstd frame magic, the gzip magic.
-const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
-const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
-
-/// The header of the .blend bytes `head` (the file's first bytes, decompressed): the
-/// 12-byte form `BLENDER-v405` (pointer size, endianness, 3-digit version), or the form
-/// Blender 5.0 introduced, `BLENDER17-01v0500` (header size, format version, 4-digit version).
-pub fn parse_version(head: &[u8]) -> Option<BlenderVersion> {
-    let rest = head.strip_prefix(b"BLENDER")?;
-    let digits = match rest.first()? {
-        b'-' | b'_' => rest.get(2..5)?,
-        b'0'..=b'9' => {
-            let header_size = std::str::from_utf8(rest.get(..2)?).ok()?;
-            let header_size: usize = header_size.parse().ok()?;
-            // 7 (BLENDER) + 2 (size) + 1 (pointer) + 2 (format) + 1 (endianness) + digits.
-            rest.get(6..header_size.checked_sub(7)?)?
-        }
-        _ => return None,
-    };
-    if !digits.iter().all(u8::is_ascii_digit) || digits.len() < 3 {
-        return None;
-    }
-    let number: u32 = std::str::from_utf8(digits).ok()?.parse().ok()?;
-    Some(BlenderVersion {
-        major: number / 100,
-        minor: number % 100,
-    })
-}
-
-/// Reads the header of the .blend at `path` (decompressing the start of a zstd file).
-pub fn read_header(path: &Path) -> Result<BlendHeader, String> {
-    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
-    let mut head = [0u8; 17];
-    let n = read_up_to(&mut file, &mut head).map_err(|e| format!("cannot be read ({e})"))?;
-    let head = &head[..n];
-    let not_blend = || "does not start with a .blend header".to_string();
-    if head.starts_with(&GZIP_MAGIC) {
-        return Ok(BlendHeader {
-            version: None,
-            compression: Compression::Gzip,
-        });
-    }
-    if head.starts_with(&ZSTD_MAGIC) {
-        let file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
-        let mut decoder = ruzstd::decoding::StreamingDecoder::new(file)
-            .map_err(|e| format!("is compressed, but its zstd stream cannot be read ({e})"))?;
-        let mut inner = [0u8; 17];
-        let n = read_up_to(&mut decoder, &mut inner)
-            .map_err(|e| format!("is compressed, but its zstd stream cannot be read ({e})"))?;
-        let version = parse_version(&inner[..n]).ok_or_else(not_blend)?;
-        return Ok(BlendHeader {
-            version: Some(version),
-            compression: Compression::Zstd,
-        });
-    }
-    let version = parse_version(head).ok_or_else(not_blend)?;
-    Ok(BlendHeader {
-        version: Some(version),
-        compression: Compression::None,
-    })
-}
-
-/// Fills `buf` as far as the reader goes; returns how many bytes were read.
-pub(crate) fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut filled = 0;
-    while filled < buf.len() {
-        match reader.read(&mut buf[filled..])? {
-            0 => break,
-            n => filled += n,
-        }
-    }
-    Ok(filled)
-}
 
 /// A user's .blend, checked and ready to be changed in place.
 #[derive(Clone, Debug)]
@@ -375,42 +282,6 @@ fn newer(saved_by: BlenderVersion, blender: BlenderVersion) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn v(major: u32, minor: u32) -> Option<BlenderVersion> {
-        Some(BlenderVersion { major, minor })
-    }
-
-    #[test]
-    fn both_header_forms_give_the_version() {
-        // The first bytes of files saved by Blender 3.4.1, bpy 4.5 and bpy 5.0 (uncompressed).
-        assert_eq!(parse_version(b"BLENDER-v304RENDH"), v(3, 4));
-        assert_eq!(parse_version(b"BLENDER-v405RENDH"), v(4, 5));
-        assert_eq!(parse_version(b"BLENDER_V279"), v(2, 79));
-        assert_eq!(parse_version(b"BLENDER17-01v0500"), v(5, 0));
-        assert_eq!(parse_version(b"BLENDER17-01v0502"), v(5, 2));
-        assert_eq!(parse_version(b"BLENDER17-01v1203"), v(12, 3));
-    }
-
-    #[test]
-    fn what_is_not_a_header_gives_none() {
-        for bad in [
-            &b""[..],
-            b"BLENDER",
-            b"BLENDER-v4",
-            b"BLENDER-vabc",
-            b"BLENDEX-v405",
-            b"BLENDER17-01v05",
-            b"BLENDER03-01v0500",
-            b"PK\x03\x04",
-        ] {
-            assert_eq!(
-                parse_version(bad),
-                None,
-                "{:?}",
-                String::from_utf8_lossy(bad)
-            );
-        }
-    }
 
     #[test]
     fn only_a_newer_major_or_minor_is_newer() {

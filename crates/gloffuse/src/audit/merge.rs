@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use super::file_costs;
+use super::shard_cost::file_costs;
 use super::verdict::{AuditReport, AuditedFile, ShardRun};
 use crate::plural::count;
 use crate::shard::{assign, in_order};

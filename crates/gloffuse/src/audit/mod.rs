@@ -6,11 +6,14 @@
 //! caller and dropped before the next file starts.
 
 pub mod files;
+mod fix;
 pub mod fix_choice;
 pub mod job;
 pub mod judge;
 pub mod merge;
 pub mod rules;
+mod shard_cost;
+mod twins;
 pub mod verdict;
 
 pub use verdict::{
@@ -18,26 +21,25 @@ pub use verdict::{
     Fixed, ShardInput, ShardRun, Verdict,
 };
 
-use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
+use crate::blend_file::read_header;
 use crate::blend_file::{MATERIAL, count_blocks};
 use crate::blender::{Blender, BlenderOptions, find_for_files};
 use crate::file_lock::Wait;
-use crate::fit::Coefficients;
-use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-use crate::measure::{BlenderVersion, Distribution, Engine};
-use crate::output::{check_destination, temp_beside};
+use crate::measure::BlenderVersion;
+use crate::output::check_destination;
 use crate::plural::count;
 use crate::progress::Progress;
 use crate::shard::Shard;
-use crate::user_blend::{LockedBlend, UserBlend, read_header};
 use crate::verify::RenderSettings;
 use crate::verify::image::{Rgba, read_rgba};
 use crate::{Error, Field, Hint};
-use job::{FixItem, FixOutput, JobRun, JobSettings, run_job};
+use fix::{Destination, FixPlan, check_fix_targets, fix_file, fix_targets};
+use job::{JobRun, JobSettings};
 use judge::{Grid, judge_material};
 use rules::Predictor;
+use twins::{TwinGroups, run_twinned};
 
 /// Where fixed files go.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -116,9 +118,7 @@ pub fn audit_with(
 fn checked_files(o: &AuditOptions) -> Result<Vec<PathBuf>, Error> {
     check(o)?;
     let files = files::blend_files(&o.paths)?;
-    check_fix_inputs(o, &files)?;
-    check_fix_dir_names(o, &files)?;
-    check_fix_not_input(o, &files)?;
+    check_fix_targets(o, &files)?;
     Ok(files)
 }
 
@@ -214,8 +214,8 @@ fn files_to_audit(
     match o.shard {
         None => (files.to_vec(), counts),
         Some(shard) => {
-            report.shard = Some(shard_run(shard, files, &counts));
-            shard_part(shard, files, counts)
+            report.shard = Some(shard_cost::shard_run(shard, files, &counts));
+            shard_cost::shard_part(shard, files, counts)
         }
     }
 }
@@ -243,43 +243,6 @@ fn audit_one(
         )),
         Ok(ok) => Ok(ok),
     }
-}
-
-/// What a Blender start costs, in materials' audit time: the split balances each file's
-/// materials plus one start. Measured (docs/FARM.md): 19 materials in Blender 3.4, 7 in
-/// bpy 4.5; one constant for every Blender, between the two.
-const START_COST: u64 = 12;
-
-/// Each file's cost to the split: its materials and a Blender start.
-fn file_costs(materials: &[usize]) -> Vec<u64> {
-    materials.iter().map(|&m| m as u64 + START_COST).collect()
-}
-
-/// A shard's place in the run: every file of the run, with its material count.
-fn shard_run(shard: Shard, files: &[PathBuf], counts: &[usize]) -> ShardRun {
-    ShardRun {
-        shard,
-        inputs: files
-            .iter()
-            .zip(counts)
-            .map(|(f, &materials)| ShardInput {
-                file: f.display().to_string(),
-                materials,
-            })
-            .collect(),
-    }
-}
-
-/// The files (and their material counts) `shard` audits.
-fn shard_part(shard: Shard, files: &[PathBuf], counts: Vec<usize>) -> (Vec<PathBuf>, Vec<usize>) {
-    let costs = file_costs(&counts);
-    files
-        .iter()
-        .cloned()
-        .zip(counts)
-        .zip(shard.takes(&costs))
-        .filter_map(|(kept, takes)| takes.then_some(kept))
-        .unzip()
 }
 
 /// The report before any file: how the audit runs and judges.
@@ -334,231 +297,6 @@ fn check(o: &AuditOptions) -> Result<(), Error> {
     Ok(())
 }
 
-/// `--fix OUT` takes one input file.
-fn check_fix_inputs(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
-    match &o.fix {
-        FixTarget::File(out) if files.len() != 1 => Err(Error::input(
-            Field::Fix,
-            out.display(),
-            Hint::new(
-                format!(
-                    "one input .blend ({} were found): for several, use {{}}",
-                    files.len()
-                ),
-                [Field::FixDir],
-            ),
-        )),
-        _ => Ok(()),
-    }
-}
-
-/// `--fix-dir` writes each input under its path relative to the folder it was found in:
-/// two inputs that would land on one path (`a/x.blend b/x.blend`) are refused, naming both,
-/// rather than one fixed copy silently replacing the other.
-fn check_fix_dir_names(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
-    let FixTarget::Dir(dir) = &o.fix else {
-        return Ok(());
-    };
-    let mut seen: std::collections::BTreeMap<PathBuf, &PathBuf> = Default::default();
-    for file in files {
-        let relative = relative_to_root(file, &o.paths);
-        if let Some(first) = seen.insert(relative.clone(), file) {
-            return Err(Error::input(
-                Field::FixDir,
-                dir.display(),
-                Hint::text(format!(
-                    "a folder where each input's fixed copy has a path of its own: {} and {} \
-                     would both be written to {} (audit them in two runs, or name the folders \
-                     that hold them so that their paths below those folders differ)",
-                    first.display(),
-                    file.display(),
-                    dir.join(&relative).display()
-                )),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// A fixed copy never replaces its input (`--fix x.blend` of x.blend, `--fix-dir` of the
-/// folder audited): that is `--in-place`, which keeps a backup and takes the file's lock.
-fn check_fix_not_input(o: &AuditOptions, files: &[PathBuf]) -> Result<(), Error> {
-    let real = |p: &Path| std::fs::canonicalize(p).ok();
-    for file in files {
-        let (field, given, dest) = match &o.fix {
-            FixTarget::File(out) => (Field::Fix, out, out.clone()),
-            FixTarget::Dir(dir) => (
-                Field::FixDir,
-                dir,
-                dir.join(relative_to_root(file, &o.paths)),
-            ),
-            FixTarget::None | FixTarget::InPlace => return Ok(()),
-        };
-        if real(&dest).is_some_and(|d| real(file) == Some(d)) {
-            let expected = match &o.fix {
-                // The path goes in as text: a `{}` in a file name is no template.
-                FixTarget::Dir(_) => Hint::text(format!(
-                    "a folder where no fixed copy is written over its input ({} would be; to \
-                     fix the files themselves, use ",
-                    file.display()
-                ))
-                .then(Hint::new("{})", [Field::InPlace])),
-                _ => Hint::new(
-                    "a path other than the audited file (to fix the file itself, use {})",
-                    [Field::InPlace],
-                ),
-            };
-            return Err(Error::input(field, given.display(), expected));
-        }
-    }
-    Ok(())
-}
-
-/// How one file's fix is written.
-struct FixPlan {
-    /// The input, checked (its header: version and compression).
-    input: UserBlend,
-    /// Where the fixed file goes; `None`: the input itself.
-    dest: Option<PathBuf>,
-    /// When the audit began: a `.blend1` made since then is another gloffuse's, kept.
-    began: std::time::SystemTime,
-}
-
-/// Each file's fix plan, checked before any render: no file saved by a newer Blender unless
-/// a downgrade is allowed. A file that cannot be fixed is that file's error: the others are
-/// audited and fixed all the same.
-fn fix_targets(
-    o: &AuditOptions,
-    files: &[PathBuf],
-    blender: &Blender,
-) -> Vec<Result<Option<FixPlan>, Error>> {
-    let began = std::time::SystemTime::now();
-    let field = match &o.fix {
-        FixTarget::None => return files.iter().map(|_| Ok(None)).collect(),
-        FixTarget::File(_) => Field::Fix,
-        FixTarget::Dir(_) => Field::FixDir,
-        FixTarget::InPlace => Field::InPlace,
-    };
-    files
-        .iter()
-        .map(|file| {
-            let input = UserBlend::open(file, field, blender.version, o.allow_downgrade)?;
-            let dest = match &o.fix {
-                FixTarget::File(out) => Some(out.clone()),
-                FixTarget::Dir(dir) => Some(dir.join(relative_to_root(file, &o.paths))),
-                _ => None,
-            };
-            Ok(Some(FixPlan { input, dest, began }))
-        })
-        .collect()
-}
-
-/// `file`'s path below the folder it was found in (its name, when it was named itself).
-fn relative_to_root(file: &Path, roots: &[PathBuf]) -> PathBuf {
-    roots
-        .iter()
-        .filter(|r| r.is_dir())
-        .find_map(|r| file.strip_prefix(r).ok())
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| file.file_name().map(PathBuf::from).unwrap_or_default())
-}
-
-/// The gloffuse groups twins use, built on a job's first request and grown to cover every
-/// later one: their tables take seconds to compute, so an audit whose materials need none
-/// never computes them, and one that does computes only the distributions and modes asked.
-struct TwinGroups<'a> {
-    blender: &'a Blender,
-    needs: BTreeSet<(Mode, Distribution)>,
-    params: Option<GenerateParams>,
-}
-
-impl<'a> TwinGroups<'a> {
-    fn new(blender: &'a Blender) -> Self {
-        TwinGroups {
-            blender,
-            needs: BTreeSet::new(),
-            params: None,
-        }
-    }
-
-    /// Groups covering `needs` (the job's (mode, distribution enum) pairs) and every earlier need.
-    fn cover(&mut self, needs: &[(String, String)], log: &Path) -> Result<&GenerateParams, Error> {
-        let mut grew = self.params.is_none();
-        for (mode, distribution) in needs {
-            let need = Mode::ALL
-                .into_iter()
-                .find(|m| m.key() == mode)
-                .zip(distribution.parse::<Distribution>().ok())
-                .filter(|(m, _)| matches!(m, Mode::Multiscatter | Mode::Layered))
-                .ok_or_else(|| Error::Blender {
-                    message: format!("the audit job asked for groups gloffuse does not build ({mode}, {distribution})").into(),
-                    log: Some(log.to_path_buf()),
-                    command: None,
-                })?;
-            grew |= self.needs.insert(need);
-        }
-        if grew {
-            let (mut coefficients, source) =
-                Coefficients::load_or_preset(None, Engine::Cycles, self.blender.version)?;
-            coefficients
-                .distributions
-                .retain(|d, _| self.needs.iter().any(|(_, n)| n == d));
-            let modes: Vec<Mode> = Mode::ALL
-                .into_iter()
-                .filter(|m| self.needs.iter().any(|(n, _)| n == m))
-                .collect();
-            self.params = Some(GenerateParams::new(
-                Curves::Pinned {
-                    coefficients: &coefficients,
-                    name: &source,
-                },
-                &[self.blender.version.masking()],
-                &modes,
-                ColorModel::Exact,
-            )?);
-        }
-        Ok(self.params.as_ref().expect("built above"))
-    }
-}
-
-/// Runs the job on `file`, and again with the gloffuse groups its twins asked for.
-fn run_twinned(
-    s: &JobSettings,
-    twins: &mut TwinGroups,
-    file: &Path,
-    fix: Option<FixOutput>,
-) -> Result<JobRun, Error> {
-    let first = run_job(
-        &JobSettings {
-            groups: twins.params.as_ref(),
-            ..*s
-        },
-        file,
-        fix,
-    )?;
-    if first.result.needs.is_empty() {
-        return Ok(first);
-    }
-    let groups = twins.cover(&first.result.needs, &first.log)?;
-    let second = run_job(
-        &JobSettings {
-            groups: Some(groups),
-            ..*s
-        },
-        file,
-        fix,
-    )?;
-    if second.result.needs.is_empty() {
-        Ok(second)
-    } else {
-        Err(Error::Blender {
-            message: "the audit job asked again for the groups it was given".into(),
-            log: Some(second.log),
-            command: None,
-        })
-    }
-}
-
 /// A file's entry, its materials, its grid, and the path its fix was installed at.
 type FileAudit = (
     AuditedFile,
@@ -584,79 +322,19 @@ fn audit_file(
         cancel: &o.blender.cancel,
         progress: Some(progress),
     };
-    let (target, temp) = match fix {
-        None => (None, None),
-        Some(FixPlan {
-            input,
-            dest: None,
-            began,
-        }) => {
-            let locked = input.lock(&wait, *began)?;
-            let temp = locked.temp()?;
-            (Some(Installing::InPlace(locked)), Some(temp))
-        }
-        Some(FixPlan {
-            dest: Some(dest), ..
-        }) => {
-            if let Some(dir) = dest.parent() {
-                std::fs::create_dir_all(dir).map_err(|e| Error::Write {
-                    path: dir.to_path_buf(),
-                    message: e.to_string(),
-                })?;
-            }
-            (
-                Some(Installing::Copy(dest)),
-                Some(temp_beside(dest, ".blend")?),
-            )
-        }
-    };
+    let destination = fix
+        .map(|plan| Destination::prepare(plan, &wait))
+        .transpose()?;
     let job = run_twinned(s, twins, &real, None)?;
     let image = read_grids(&job)?;
     judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
-    let (mut file_entry, mut materials) = judged(file, &job, image.as_ref(), o, predictor);
-    if matches!(target, Some(Installing::InPlace(_))) {
-        keep_a_partly_read_file(&file_entry, &mut materials);
-    }
-    let mut installed = None;
-    if let (Some(target), Some(temp), Some(plan)) = (target, temp, fix) {
-        let chosen = chosen_fixes(&materials);
-        if chosen.is_empty() && matches!(target, Installing::InPlace(_)) {
-            return Ok((file_entry, materials, image, None));
-        }
-        o.blender.cancel.check()?;
-        let fixed = FixOutput {
-            path: &temp,
-            compress: plan.input.compressed(),
-            materials: &chosen,
-        };
-        let (replaced, after) = fix_and_audit(s, twins, &real, fixed, o, predictor)?;
-        o.blender.cancel.check()?;
-        if let Some((mut entry, path)) = install_fix(target, temp, replaced)? {
-            match after {
-                Ok(after) => attach_after(&mut materials, after),
-                Err(e) => entry.after_error = Some(e),
-            }
-            file_entry.fixed = Some(entry);
-            installed = Some(path);
-        }
-    }
+    let mut audited = judged(file, &job, image.as_ref(), o, predictor);
+    let installed = match destination {
+        None => None,
+        Some(destination) => fix_file(s, twins, &real, destination, o, predictor, &mut audited)?,
+    };
+    let (file_entry, materials) = audited;
     Ok((file_entry, materials, image, installed))
-}
-
-/// A file Blender loaded only in part (a `load-warning`) is never saved over: what Blender
-/// could not read would be gone from it. Its fixes become reasons.
-fn keep_a_partly_read_file(file: &AuditedFile, materials: &mut [AuditedMaterial]) {
-    if !file.findings.iter().any(|f| f.rule == "load-warning") {
-        return;
-    }
-    for m in materials.iter_mut().filter(|m| m.fix.is_some()) {
-        m.fix = None;
-        m.no_fix = Some(
-            "not fixed in place: Blender could not read all of this file (load-warning), so \
-             saving over it would drop what it could not read; fix it into a copy instead"
-                .to_string(),
-        );
-    }
 }
 
 /// The file Blender opens for `file` (every link followed). A file that is no .blend (a
@@ -674,39 +352,6 @@ fn blend_to_open(file: &Path) -> Result<PathBuf, Error> {
             Hint::text(format!("a .blend file (this file {why})")),
         )),
     }
-}
-
-/// The fixes the judged materials call for, in the job's material order.
-fn chosen_fixes(materials: &[AuditedMaterial]) -> Vec<FixItem> {
-    materials
-        .iter()
-        .enumerate()
-        .filter_map(|(material, m)| {
-            m.fix.map(|f| FixItem {
-                material,
-                scale: f.scale,
-            })
-        })
-        .collect()
-}
-
-/// Fixes `file` into `fixed.path` and audits the copy: the lobes replaced, and the copy's
-/// materials judged (or why they could not be).
-fn fix_and_audit(
-    s: &JobSettings,
-    twins: &mut TwinGroups,
-    file: &Path,
-    fixed: FixOutput,
-    o: &AuditOptions,
-    predictor: &mut Predictor,
-) -> Result<(usize, Result<Vec<AuditedMaterial>, String>), Error> {
-    let job = run_twinned(s, twins, file, Some(fixed))?;
-    let replaced = job.result.fixed.as_ref().map_or(0, |f| f.replaced);
-    let after = read_grids(&job).and_then(|image| {
-        judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
-        Ok(judged(fixed.path, &job, image.as_ref(), o, predictor).1)
-    });
-    Ok((replaced, after.map_err(|e| e.to_string())))
 }
 
 /// The job's grid: the materials' render, with the twins' stacked below it when there is
@@ -788,60 +433,6 @@ fn judged(
         fixed: None,
     };
     (entry, materials)
-}
-
-/// Where a fixed file goes.
-enum Installing<'a> {
-    /// Over the input itself, under its writers' lock.
-    InPlace(LockedBlend),
-    /// A copy at this path.
-    Copy(&'a Path),
-}
-
-/// Puts a fixed file in place: a copy renamed to its destination, or the input replaced
-/// through `LockedBlend::install` (its previous version kept as `.blend1`). An in-place fix
-/// that replaced nothing leaves the file alone. Returns the entry and the path installed.
-fn install_fix(
-    target: Installing,
-    temp: tempfile::TempPath,
-    replaced: usize,
-) -> Result<Option<(Fixed, PathBuf)>, Error> {
-    let (path, backup) = match target {
-        Installing::InPlace(_) if replaced == 0 => return Ok(None),
-        Installing::InPlace(locked) => {
-            let real = locked.blend.real.clone();
-            let backup = locked.install(temp)?;
-            (real, Some(backup.display().to_string()))
-        }
-        Installing::Copy(dest) => {
-            temp.persist(dest).map_err(|e| Error::Write {
-                path: dest.to_path_buf(),
-                message: e.error.to_string(),
-            })?;
-            (dest.to_path_buf(), None)
-        }
-    };
-    let fixed = Fixed {
-        path: path.display().to_string(),
-        replaced,
-        backup,
-        after_error: None,
-    };
-    Ok(Some((fixed, path)))
-}
-
-fn attach_after(materials: &mut [AuditedMaterial], after: Vec<AuditedMaterial>) {
-    for m in materials {
-        m.after = after
-            .iter()
-            .find(|a| a.material == m.material)
-            .map(|a| After {
-                rewritten: m.fix.is_some(),
-                verdict: a.verdict,
-                mean: a.mean,
-                findings: a.findings.len(),
-            });
-    }
 }
 
 /// A file that could not be audited, with why. Where a Blender older than the file failed

@@ -10,9 +10,9 @@
 use std::path::PathBuf;
 
 use super::{BPY_VERSION, Blender, BlenderOptions, Need};
+use crate::blend_file::read_header;
 use crate::measure::BlenderVersion;
 use crate::progress::Progress;
-use crate::user_blend::read_header;
 use crate::{Error, Field};
 
 /// The Blender for `files` under `options` (a Blender the user named is used as named),

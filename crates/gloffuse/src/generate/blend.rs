@@ -3,17 +3,12 @@
 
 use std::path::Path;
 
-use crate::user_blend::{Compression, read_header};
-
-/// The magic that ends Zstandard's seekable format, which Blender's compressed .blend
-/// files end with (its seek table, little-endian 0x8F92EAB1).
-const SEEKABLE_FOOTER: [u8; 4] = [0xb1, 0xea, 0x92, 0x8f];
+use crate::blend_file::{ends_complete, read_header};
 
 /// Why the .blend Blender saved at `path` is unusable, if it is: missing or empty, not a
 /// .blend, or cut short: an uncompressed file lacks the `ENDB` block that closes every
 /// complete .blend in its last bytes, a compressed one the seek table that ends it.
 pub fn incomplete_blend(path: &Path) -> Option<String> {
-    use std::io::{Read, Seek, SeekFrom};
     let shown = path.display();
     let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     if len == 0 {
@@ -27,18 +22,7 @@ pub fn incomplete_blend(path: &Path) -> Option<String> {
             ));
         }
     };
-    let mut tail = vec![0u8; len.min(64) as usize];
-    let read = std::fs::File::open(path).and_then(|mut f| {
-        f.seek(SeekFrom::End(-(tail.len() as i64)))?;
-        f.read_exact(&mut tail)
-    });
-    let complete = read.is_ok()
-        && match header.compression {
-            Compression::None => tail.windows(4).any(|w| w == b"ENDB"),
-            Compression::Zstd => tail.ends_with(&SEEKABLE_FOOTER),
-            Compression::Gzip => true,
-        };
-    (!complete).then(|| {
+    (!ends_complete(path, &header)).then(|| {
         format!(
             "the .blend it wrote is truncated or corrupt ({shown} lacks the end a complete .blend has)"
         )

@@ -26,6 +26,7 @@ use serde::Serialize;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
+use crate::blend_file::read_header;
 use crate::blender::{
     Blender, BlenderOptions, Run, RunOutput, command_line, find_for_files, run_following_steps,
 };
@@ -35,7 +36,7 @@ use crate::fit::{Coefficients, preset_for};
 use crate::measure::{BlenderVersion, Engine, Masking};
 use crate::output::{Destination, check_destination, keep_beside, temp_beside, write_output};
 use crate::progress::Progress;
-use crate::user_blend::{LockedBlend, UserBlend, read_header};
+use crate::user_blend::{LockedBlend, UserBlend};
 use blend::incomplete_blend;
 
 /// What `generate` writes, and from what.
