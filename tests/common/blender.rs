@@ -83,25 +83,30 @@ pub fn label_of(test: &str) -> &'static str {
 /// str, blender: PathBuf)`: a module `NAME` holding `in_blender_3_4`, `in_blender_4_5` and
 /// `in_blender_5_0`, each calling `NAME` with its Blender (skipped as [`real_blender`]
 /// says), so one failing version hides no other. `per_blender!(NAME: in_blender_4_5, …)`
-/// stamps only those listed.
+/// stamps only those listed; attributes before `NAME` (`#[ignore]`) go on every test.
 #[allow(unused_macros)]
 macro_rules! per_blender {
-    ($name:ident) => {
+    (@test [$($attr:tt)*] $name:ident $test:ident) => {
+        #[test]
+        $($attr)*
+        fn $test() {
+            let label = $crate::common::blender::label_of(stringify!($test));
+            if let Some(blender) = $crate::common::blender::real_blender(label) {
+                super::$name(label, blender);
+            }
+        }
+    };
+    ($(#[$attr:meta])* $name:ident) => {
         $crate::common::blender::per_blender!(
-            $name: in_blender_3_4, in_blender_4_5, in_blender_5_0
+            $(#[$attr])* $name: in_blender_3_4, in_blender_4_5, in_blender_5_0
         );
     };
-    ($name:ident: $($test:ident),+) => {
+    ($(#[$attr:meta])* $name:ident: $($test:ident),+) => {
+        $crate::common::blender::per_blender!(@tests [$(#[$attr])*] $name: $($test),+);
+    };
+    (@tests $attrs:tt $name:ident: $($test:ident),+) => {
         mod $name {
-            $(
-                #[test]
-                fn $test() {
-                    let label = $crate::common::blender::label_of(stringify!($test));
-                    if let Some(blender) = $crate::common::blender::real_blender(label) {
-                        super::$name(label, blender);
-                    }
-                }
-            )+
+            $($crate::common::blender::per_blender!(@test $attrs $name $test);)+
         }
     };
 }

@@ -72,12 +72,17 @@ pub fn browser() -> Option<std::path::PathBuf> {
 pub const SKIPS_FILE_VAR: &str = "GLOFFUSE_TEST_SKIPS";
 
 /// The running test gives up because `why` (something `scripts/test.sh` installs is
-/// missing): allowed only when `skip_var` is `1`, else the test fails saying so. A skip says
-/// what it skipped on stderr and appends `TEST: why` to `$GLOFFUSE_TEST_SKIPS` when set.
+/// missing): allowed only when `skip_var` is `1`, else the test fails saying so.
 pub fn skip(skip_var: &str, why: &str) {
     let asked = std::env::var_os(skip_var).is_some_and(|v| v == "1");
     assert!(asked, "{why}; set {skip_var}=1 to skip");
-    eprintln!("skipped ({skip_var}=1): {why}");
+    record_skip(&format!("{why} ({skip_var}=1)"));
+}
+
+/// The running test gives up because of `why`: said on stderr, and `TEST: why` appended to
+/// `$GLOFFUSE_TEST_SKIPS` when set.
+pub fn record_skip(why: &str) {
+    eprintln!("skipped: {why}");
     let Some(file) = std::env::var_os(SKIPS_FILE_VAR) else {
         return;
     };
