@@ -16,7 +16,8 @@ use gloffuse::measure::anisotropic::{local_direction, view};
 use gloffuse::measure::{
     AnisotropicIntegrator, AnisotropicLobe, Anisotropy, BlenderVersion, Distribution, Roughness,
 };
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 const PX: usize = 64;
 const SAMPLES: u32 = 512;
@@ -230,21 +231,31 @@ const BECKMANN_GROUP: &str = "Gloffuse Anisotropic (Beckmann)";
 const GROUP_RING_TOLERANCE: f64 = 0.02;
 const GROUP_MEAN_TOLERANCE: f64 = 0.01;
 
+/// The script `gloffuse generate --mode anisotropic --script` writes, made once for the
+/// per-version tests (in cargo's temporary folder for tests, since a static is never dropped).
+fn anisotropic_script() -> &'static Path {
+    static SCRIPT: OnceLock<PathBuf> = OnceLock::new();
+    SCRIPT.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("anisotropic-script");
+        std::fs::create_dir_all(&dir).unwrap();
+        let script = dir.join("anisotropic.py");
+        common::gloffuse()
+            .args(["generate", "--mode", "anisotropic", "--script"])
+            .arg(&script)
+            .assert()
+            .success();
+        script
+    })
+}
+
 /// `Gloffuse Anisotropic (GGX)` (and from 3.5 its Beckmann twin), built in each Blender by
 /// the script `gloffuse generate
 /// --mode anisotropic --script` writes, renders a white furnace sphere at 100 % in every
 /// ring for strong anisotropy of both signs, roughness up to 1, a turned tangent and
 /// Cycles' default tangent (the Tangent input unconnected). Blender's own Multiscatter
 /// GGX with the same anisotropy is rendered beside it for the record (docs/RESULTS.md).
-#[test]
-fn the_anisotropic_group_renders_every_ring_at_100_percent() {
-    let dir = tempfile::tempdir().unwrap();
-    let script = dir.path().join("anisotropic.py");
-    common::gloffuse()
-        .args(["generate", "--mode", "anisotropic", "--script"])
-        .arg(&script)
-        .assert()
-        .success();
+fn the_anisotropic_group_renders_every_ring_at_100_percent(label: &'static str, _blender: PathBuf) {
+    let script = anisotropic_script();
     let ggx = [
         (0.7, 0.8, 0.0),
         (1.0, -0.9, 0.0),
@@ -254,54 +265,54 @@ fn the_anisotropic_group_renders_every_ring_at_100_percent() {
     ];
     // Beckmann from 3.5 (3.0–3.4 sample the wrong lobe, and the script builds no group).
     let beckmann = [(0.8, -0.7, 0.0), (0.5, 0.9, 0.25)];
-    for label in ["3.4", "4.5", "5.0"] {
-        let mut cases: Vec<(&str, (f64, f64, f64))> = ggx.iter().map(|&c| (GROUP, c)).collect();
-        if label != "3.4" {
-            cases.extend(beckmann.iter().map(|&c| (BECKMANN_GROUP, c)));
-        }
-        let mut request_cases: Vec<serde_json::Value> = cases
-            .iter()
-            .map(|&(group, (r, a, t))| {
-                serde_json::json!({"group": group, "distribution": "GGX", "roughness": r,
-                                   "anisotropy": a, "rotation": t})
-            })
-            .collect();
-        request_cases.push(
-            serde_json::json!({"distribution": "MULTI_GGX", "roughness": 0.7,
-                                              "anisotropy": 0.8}),
-        );
-        let request = serde_json::json!({
-            "px": PX, "samples": 256, "script": script, "cases": request_cases,
-        });
-        let Some(renders) = render_cases(label, "anisotropic_sphere.py", &request, PX) else {
-            continue;
-        };
-        for (&(group, (r, a, t)), pixels) in cases.iter().zip(&renders) {
-            let (rings, mean) = tenth_rings(pixels);
-            let what = format!("Blender {label}: {group} r {r} anisotropy {a} rotation {t}");
-            let text: Vec<String> = rings.iter().map(|v| format!("{v:.4}")).collect();
-            eprintln!("{what}: mean {mean:.4}, rings μ 0.1–1: {}", text.join(" "));
-            assert!(
-                (mean - 1.0).abs() < GROUP_MEAN_TOLERANCE,
-                "{what}: the sphere's mean is {mean:.4}"
-            );
-            for (k, v) in rings.iter().enumerate() {
-                assert!(
-                    (v - 1.0).abs() < GROUP_RING_TOLERANCE,
-                    "{what}: ring μ {:.1}–{:.1} renders {v:.4}",
-                    0.1 * (k + 1) as f64,
-                    0.1 * (k + 2) as f64
-                );
-            }
-        }
-        let (rings, mean) = tenth_rings(&renders[cases.len()]);
-        let text: Vec<String> = rings.iter().map(|v| format!("{v:.4}")).collect();
-        eprintln!(
-            "Blender {label}: Multiscatter GGX r 0.7 anisotropy 0.8: mean {mean:.4}, rings μ 0.1–1: {}",
-            text.join(" ")
-        );
+    let mut cases: Vec<(&str, (f64, f64, f64))> = ggx.iter().map(|&c| (GROUP, c)).collect();
+    if label != "3.4" {
+        cases.extend(beckmann.iter().map(|&c| (BECKMANN_GROUP, c)));
     }
+    let mut request_cases: Vec<serde_json::Value> = cases
+        .iter()
+        .map(|&(group, (r, a, t))| {
+            serde_json::json!({"group": group, "distribution": "GGX", "roughness": r,
+                               "anisotropy": a, "rotation": t})
+        })
+        .collect();
+    request_cases.push(
+        serde_json::json!({"distribution": "MULTI_GGX", "roughness": 0.7,
+                                          "anisotropy": 0.8}),
+    );
+    let request = serde_json::json!({
+        "px": PX, "samples": 256, "script": script, "cases": request_cases,
+    });
+    let Some(renders) = render_cases(label, "anisotropic_sphere.py", &request, PX) else {
+        return;
+    };
+    for (&(group, (r, a, t)), pixels) in cases.iter().zip(&renders) {
+        let (rings, mean) = tenth_rings(pixels);
+        let what = format!("Blender {label}: {group} r {r} anisotropy {a} rotation {t}");
+        let text: Vec<String> = rings.iter().map(|v| format!("{v:.4}")).collect();
+        eprintln!("{what}: mean {mean:.4}, rings μ 0.1–1: {}", text.join(" "));
+        assert!(
+            (mean - 1.0).abs() < GROUP_MEAN_TOLERANCE,
+            "{what}: the sphere's mean is {mean:.4}"
+        );
+        for (k, v) in rings.iter().enumerate() {
+            assert!(
+                (v - 1.0).abs() < GROUP_RING_TOLERANCE,
+                "{what}: ring μ {:.1}–{:.1} renders {v:.4}",
+                0.1 * (k + 1) as f64,
+                0.1 * (k + 2) as f64
+            );
+        }
+    }
+    let (rings, mean) = tenth_rings(&renders[cases.len()]);
+    let text: Vec<String> = rings.iter().map(|v| format!("{v:.4}")).collect();
+    eprintln!(
+        "Blender {label}: Multiscatter GGX r 0.7 anisotropy 0.8: mean {mean:.4}, rings μ 0.1–1: {}",
+        text.join(" ")
+    );
 }
+
+common::blender::per_blender!(the_anisotropic_group_renders_every_ring_at_100_percent);
 
 /// A library of the anisotropic groups alone, made by Blender 3.4, passes
 /// `tests/blender/check_assets.py`: every group has a rendered preview (the shading-normal
@@ -372,51 +383,50 @@ fn an_anisotropic_library_passes_the_asset_checks() {
 /// tangent the world X) at the integrator's sphere mean of E(μ, φ) within 0.5 % (two
 /// independent routes), and Blender's Multiscatter GGX beside them: short in 4.5 and 5.0
 /// (its isotropic table), at 100 % in 3.4 (its random walk).
-#[test]
-fn verify_judges_the_anisotropic_groups_in_every_blender() {
-    for (label, blender) in common::blender::real_blenders() {
-        let args = [
-            "--mode",
-            "anisotropic",
-            "--roughness",
-            "0.5,1",
-            "--anisotropy",
-            "0.9,-0.9",
-        ];
-        let (code, v) = common::verify_json(&blender, &args);
-        assert_eq!(code, 0, "Blender {label}: {v:#}");
-        assert_eq!(v["pass"], true, "Blender {label}");
-        let rows = v["rows"].as_array().unwrap();
-        // Beckmann's anisotropic group exists from 3.5 on.
-        let distributions = if label == "3.4" { 1 } else { 2 };
-        assert_eq!(rows.len(), distributions * 2 * 2, "Blender {label}");
-        for r in rows {
-            let what = format!(
-                "Blender {label} {} r {} anisotropy {}",
-                r["distribution"], r["roughness"], r["anisotropy"]
-            );
-            assert!(r["anisotropy"].is_f64(), "{what}");
-            let rendered = r["uncorrected_brightness"].as_f64().unwrap();
-            let predicted = r["predicted_uncorrected"].as_f64().unwrap();
-            assert!(
-                (rendered / predicted - 1.0).abs() < 0.005,
-                "{what}: rendered {rendered}, predicted {predicted}"
-            );
-            assert!(rendered < 0.9, "{what}: the lobe loses energy ({rendered})");
-            assert!(r["deviation"].as_f64().unwrap() <= 0.01, "{what}");
-            assert!(r["worst_ring"].as_f64().unwrap() <= 0.015, "{what}");
-        }
-        for m in v["reference"].as_array().unwrap() {
-            let what = format!(
-                "Blender {label} Multiscatter GGX r {} anisotropy {}",
-                m["roughness"], m["anisotropy"]
-            );
-            let brightness = m["brightness"].as_f64().unwrap();
-            if label == "3.4" {
-                assert!((brightness - 1.0).abs() < 0.01, "{what}: {brightness}");
-            } else {
-                assert!(brightness < 0.8, "{what}: {brightness}");
-            }
+fn verify_judges_the_anisotropic_groups_in_every_blender(label: &'static str, blender: PathBuf) {
+    let args = [
+        "--mode",
+        "anisotropic",
+        "--roughness",
+        "0.5,1",
+        "--anisotropy",
+        "0.9,-0.9",
+    ];
+    let (code, v) = common::verify_json(&blender, &args);
+    assert_eq!(code, 0, "Blender {label}: {v:#}");
+    assert_eq!(v["pass"], true, "Blender {label}");
+    let rows = v["rows"].as_array().unwrap();
+    // Beckmann's anisotropic group exists from 3.5 on.
+    let distributions = if label == "3.4" { 1 } else { 2 };
+    assert_eq!(rows.len(), distributions * 2 * 2, "Blender {label}");
+    for r in rows {
+        let what = format!(
+            "Blender {label} {} r {} anisotropy {}",
+            r["distribution"], r["roughness"], r["anisotropy"]
+        );
+        assert!(r["anisotropy"].is_f64(), "{what}");
+        let rendered = r["uncorrected_brightness"].as_f64().unwrap();
+        let predicted = r["predicted_uncorrected"].as_f64().unwrap();
+        assert!(
+            (rendered / predicted - 1.0).abs() < 0.005,
+            "{what}: rendered {rendered}, predicted {predicted}"
+        );
+        assert!(rendered < 0.9, "{what}: the lobe loses energy ({rendered})");
+        assert!(r["deviation"].as_f64().unwrap() <= 0.01, "{what}");
+        assert!(r["worst_ring"].as_f64().unwrap() <= 0.015, "{what}");
+    }
+    for m in v["reference"].as_array().unwrap() {
+        let what = format!(
+            "Blender {label} Multiscatter GGX r {} anisotropy {}",
+            m["roughness"], m["anisotropy"]
+        );
+        let brightness = m["brightness"].as_f64().unwrap();
+        if label == "3.4" {
+            assert!((brightness - 1.0).abs() < 0.01, "{what}: {brightness}");
+        } else {
+            assert!(brightness < 0.8, "{what}: {brightness}");
         }
     }
 }
+
+common::blender::per_blender!(verify_judges_the_anisotropic_groups_in_every_blender);

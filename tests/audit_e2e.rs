@@ -181,40 +181,42 @@ fn check_reports(label: &str, report: &Value, junit: &Path, dir: &Path) {
 }
 
 /// The whole library, in each Blender: one audit with every report.
-#[test]
-fn every_material_of_the_library_gets_the_verdict_the_oracle_expects() {
-    for (label, blender) in common::blender::real_blenders() {
-        let views = tempfile::tempdir().unwrap();
-        let library = tempfile::tempdir().unwrap();
-        let out = tempfile::tempdir().unwrap();
-        let gloffuse_library = view_library(&blender, views.path());
-        let expected = make_library(&blender, library.path(), Some(&gloffuse_library));
-        let before = snapshot(library.path());
-        let (report_dir, junit) = (out.path().join("report"), out.path().join("audit.xml"));
-        let (code, report, stderr) = audit(
-            &blender,
-            &[
-                library.path().as_os_str(),
-                "--report".as_ref(),
-                report_dir.as_os_str(),
-                "--junit".as_ref(),
-                junit.as_os_str(),
-            ],
-        );
-        assert_eq!(
-            code, 1,
-            "Blender {label}: materials lose and create\n{stderr}"
-        );
-        assert_eq!(report["passed"], false);
-        check_against_oracle(label, &report, &expected, library.path());
-        check_furnace(label, &report);
-        check_reports(label, &report, &junit, &report_dir);
-        assert!(
-            snapshot(library.path()) == before,
-            "Blender {label}: the audit changed or added a file in the user's folder"
-        );
-    }
+fn every_material_of_the_library_gets_the_verdict_the_oracle_expects(
+    label: &'static str,
+    blender: PathBuf,
+) {
+    let views = tempfile::tempdir().unwrap();
+    let library = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let gloffuse_library = view_library(&blender, views.path());
+    let expected = make_library(&blender, library.path(), Some(&gloffuse_library));
+    let before = snapshot(library.path());
+    let (report_dir, junit) = (out.path().join("report"), out.path().join("audit.xml"));
+    let (code, report, stderr) = audit(
+        &blender,
+        &[
+            library.path().as_os_str(),
+            "--report".as_ref(),
+            report_dir.as_os_str(),
+            "--junit".as_ref(),
+            junit.as_os_str(),
+        ],
+    );
+    assert_eq!(
+        code, 1,
+        "Blender {label}: materials lose and create\n{stderr}"
+    );
+    assert_eq!(report["passed"], false);
+    check_against_oracle(label, &report, &expected, library.path());
+    check_furnace(label, &report);
+    check_reports(label, &report, &junit, &report_dir);
+    assert!(
+        snapshot(library.path()) == before,
+        "Blender {label}: the audit changed or added a file in the user's folder"
+    );
 }
+
+common::blender::per_blender!(every_material_of_the_library_gets_the_verdict_the_oracle_expects);
 
 /// `--fix OUT` in 4.5: the input stays byte for byte; the copy has every twin in place
 /// (audited again: each material that had a replacement is ok after, unless its rule has

@@ -47,22 +47,21 @@ fn many_materials(blender: &Path, dir: &Path, count: usize) -> (PathBuf, usize) 
 
 /// Blender writes a compressed file as many zstd frames (one per 256 KiB) and a seek table:
 /// gloffuse counts the materials Blender lists, in each Blender.
-#[test]
-fn a_compressed_file_is_counted_through_every_frame() {
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let (file, listed) = many_materials(&blender, dir.path(), MANY);
-        assert_eq!(listed, MANY, "Blender {label}");
-        let bytes = std::fs::read(&file).unwrap();
-        assert_eq!(
-            bytes[..4],
-            [0x28, 0xb5, 0x2f, 0xfd],
-            "Blender {label}: zstd"
-        );
-        assert!(bytes.len() > 256 * 1024, "Blender {label}: several frames");
-        assert_eq!(count_blocks(&file, MATERIAL), Ok(listed), "Blender {label}");
-    }
+fn a_compressed_file_is_counted_through_every_frame(label: &'static str, blender: PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let (file, listed) = many_materials(&blender, dir.path(), MANY);
+    assert_eq!(listed, MANY, "Blender {label}");
+    let bytes = std::fs::read(&file).unwrap();
+    assert_eq!(
+        bytes[..4],
+        [0x28, 0xb5, 0x2f, 0xfd],
+        "Blender {label}: zstd"
+    );
+    assert!(bytes.len() > 256 * 1024, "Blender {label}: several frames");
+    assert_eq!(count_blocks(&file, MATERIAL), Ok(listed), "Blender {label}");
 }
+
+common::blender::per_blender!(a_compressed_file_is_counted_through_every_frame);
 
 /// A compressed file of 2,800 materials in 3.4: every material judged (half lose, half are
 /// ok), a picture each; its grid is laid out square (a grid two columns wide, 67,200 px
@@ -118,7 +117,7 @@ fn thousands_of_materials_are_judged_and_a_grid_too_large_is_an_error() {
     );
 }
 
-/// A tmpfs of `size` mounted on `dir` (unmounted on drop); `None`, said out loud, where
+/// A tmpfs of `size` mounted on `dir` (unmounted on drop); `None`, recorded as a skip, where
 /// mounting is not allowed (not root, or a container without the capability).
 struct Tmpfs(PathBuf);
 
@@ -131,15 +130,15 @@ impl Tmpfs {
         match out {
             Ok(out) if out.status.success() => Some(Tmpfs(dir.to_path_buf())),
             Ok(out) => {
-                eprintln!(
-                    "skipped: cannot mount a tmpfs on {} ({})",
+                common::record_skip(&format!(
+                    "cannot mount a tmpfs on {} ({})",
                     dir.display(),
                     String::from_utf8_lossy(&out.stderr).trim()
-                );
+                ));
                 None
             }
             Err(e) => {
-                eprintln!("skipped: cannot run mount ({e})");
+                common::record_skip(&format!("cannot run mount ({e})"));
                 None
             }
         }
@@ -155,9 +154,7 @@ impl Drop for Tmpfs {
 /// A fixed copy that does not fit on its disk: the file's error says the disk is full and
 /// names the destination, in each Blender (Blender itself says "Error: Success" or "No such
 /// file or directory").
-#[test]
-fn a_full_disk_is_named_when_a_fix_cannot_be_saved() {
-    let blenders = common::blender::real_blenders();
+fn a_full_disk_is_named_when_a_fix_cannot_be_saved(label: &'static str, blender: PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     let full = dir.path().join("full");
     std::fs::create_dir(&full).unwrap();
@@ -166,25 +163,24 @@ fn a_full_disk_is_named_when_a_fix_cannot_be_saved() {
     };
     // Leave a few pages free: room for the temporary file's name, not for a .blend.
     std::fs::write(full.join("filler"), vec![0u8; 240 * 1024]).unwrap();
-    for (label, blender) in blenders {
-        let library = tempfile::tempdir().unwrap();
-        common::audit_library::make_library(&blender, library.path(), None);
-        let out = full.join("fixed.blend");
-        let (_, report, stderr) = audit(
-            &blender,
-            &[
-                library.path().join("rules.blend").as_os_str(),
-                "--no-render".as_ref(),
-                "--fix".as_ref(),
-                out.as_os_str(),
-            ],
-        );
-        let error = report["files"][0]["error"].as_str().unwrap_or_default();
-        assert!(
-            error.contains("no space left on the device")
-                && error.contains(&*full.to_string_lossy()),
-            "Blender {label}: {error}\n{stderr}"
-        );
-        assert!(!out.exists(), "Blender {label}");
-    }
+    let library = tempfile::tempdir().unwrap();
+    common::audit_library::make_library(&blender, library.path(), None);
+    let out = full.join("fixed.blend");
+    let (_, report, stderr) = audit(
+        &blender,
+        &[
+            library.path().join("rules.blend").as_os_str(),
+            "--no-render".as_ref(),
+            "--fix".as_ref(),
+            out.as_os_str(),
+        ],
+    );
+    let error = report["files"][0]["error"].as_str().unwrap_or_default();
+    assert!(
+        error.contains("no space left on the device") && error.contains(&*full.to_string_lossy()),
+        "Blender {label}: {error}\n{stderr}"
+    );
+    assert!(!out.exists(), "Blender {label}");
 }
+
+common::blender::per_blender!(a_full_disk_is_named_when_a_fix_cannot_be_saved);

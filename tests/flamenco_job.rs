@@ -22,9 +22,7 @@ fn node() -> Option<&'static str> {
     if Command::new("node").arg("--version").output().is_ok() {
         return Some("node");
     }
-    let skip = std::env::var_os(SKIP_VAR).is_some_and(|v| v == "1");
-    assert!(skip, "node is not on PATH; set {SKIP_VAR}=1 to skip");
-    eprintln!("skipped ({SKIP_VAR}=1): node is not on PATH");
+    common::skip(SKIP_VAR, "node is not on PATH");
     None
 }
 

@@ -7,6 +7,9 @@
 
 mod common;
 
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
 use gloffuse::fit::Coefficients;
 use gloffuse::generate::{correction_group_name, shader_group_name};
 use gloffuse::measure::Engine;
@@ -161,105 +164,104 @@ const WORD_PIXELS: usize = 100;
 /// bpy 5.0.1; Ashikhmin-Shirley and Beckmann lobes are too alike to compare).
 const HIGHLIGHT_PIXELS: usize = 500;
 
-#[test]
-fn generated_blend_works_in_every_blender() {
+fn generated_blend_works_in_every_blender(label: &'static str, blender: PathBuf) {
     let checker = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/tests/blender/check_generated.py"
     );
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let sub = dir.path().join("a dir é 'q\"");
-        std::fs::create_dir(&sub).unwrap();
-        let blend = sub.join("gloffuse library.blend");
-        let script = sub.join("gen erate.py");
-        // The user's own catalogs: kept, and their "Shader" catalog is the one used.
-        let cats = sub.join("blender_assets.cats.txt");
-        std::fs::write(&cats, USER_CATALOGS).unwrap();
-        let preset = if label == "3.4" {
-            "blender-3"
-        } else {
-            "blender-4"
-        };
-        let out = common::gloffuse()
-            .args([
-                "generate",
-                "--json",
-                "--mode",
-                "roughness",
-                "--mode",
-                "view",
-            ])
-            .args([
-                "--mode",
-                "multiscatter",
-                "--mode",
-                "anisotropic",
-                "--mode",
-                "glass",
-            ])
-            .arg("--blend")
-            .arg(&blend)
-            .arg("--script")
-            .arg(&script)
-            .arg("--blender")
-            .arg(&blender)
-            .args(["--no-provision", "--timeout", "300"])
-            .assert()
-            .success()
-            .get_output()
-            .stdout
-            .clone();
-        let summary: Value = serde_json::from_slice(&out).unwrap();
-        // Without --coefficients the preset follows the Blender's masking family.
-        assert_eq!(summary["coefficients"], preset, "Blender {label}");
-        assert!(summary["blender"].as_str().unwrap().starts_with(label));
-        let leftovers: Vec<_> = std::fs::read_dir(&sub)
-            .unwrap()
-            .map(|e| e.unwrap().file_name())
-            .collect();
-        assert_eq!(
-            leftovers.len(),
-            3,
-            "Blender {label}: only the .blend, its catalogs and the script: {leftovers:?}"
-        );
-        let merged = std::fs::read_to_string(&cats).unwrap();
-        assert!(
-            merged.starts_with(USER_CATALOGS) && merged.matches(":Shader:").count() == 1,
-            "Blender {label}: the user's catalogs are kept as they are:\n{merged}"
-        );
-        check_assets(label, &blender, &blend);
+    let dir = tempfile::tempdir().unwrap();
+    let sub = dir.path().join("a dir é 'q\"");
+    std::fs::create_dir(&sub).unwrap();
+    let blend = sub.join("gloffuse library.blend");
+    let script = sub.join("gen erate.py");
+    // The user's own catalogs: kept, and their "Shader" catalog is the one used.
+    let cats = sub.join("blender_assets.cats.txt");
+    std::fs::write(&cats, USER_CATALOGS).unwrap();
+    let preset = if label == "3.4" {
+        "blender-3"
+    } else {
+        "blender-4"
+    };
+    let out = common::gloffuse()
+        .args([
+            "generate",
+            "--json",
+            "--mode",
+            "roughness",
+            "--mode",
+            "view",
+        ])
+        .args([
+            "--mode",
+            "multiscatter",
+            "--mode",
+            "anisotropic",
+            "--mode",
+            "glass",
+        ])
+        .arg("--blend")
+        .arg(&blend)
+        .arg("--script")
+        .arg(&script)
+        .arg("--blender")
+        .arg(&blender)
+        .args(["--no-provision", "--timeout", "300"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let summary: Value = serde_json::from_slice(&out).unwrap();
+    // Without --coefficients the preset follows the Blender's masking family.
+    assert_eq!(summary["coefficients"], preset, "Blender {label}");
+    assert!(summary["blender"].as_str().unwrap().starts_with(label));
+    let leftovers: Vec<_> = std::fs::read_dir(&sub)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(
+        leftovers.len(),
+        3,
+        "Blender {label}: only the .blend, its catalogs and the script: {leftovers:?}"
+    );
+    let merged = std::fs::read_to_string(&cats).unwrap();
+    assert!(
+        merged.starts_with(USER_CATALOGS) && merged.matches(":Shader:").count() == 1,
+        "Blender {label}: the user's catalogs are kept as they are:\n{merged}"
+    );
+    check_assets(label, &blender, &blend);
 
-        let expect = dir.path().join("expect.json");
-        std::fs::write(&expect, expectations(preset).to_string()).unwrap();
-        let result = dir.path().join("result.json");
-        let run = common::blender::run_in_blender(
-            &blender,
-            checker.as_ref(),
-            &[
-                "--blend".as_ref(),
-                blend.as_os_str(),
-                "--expect".as_ref(),
-                expect.as_os_str(),
-                "--out".as_ref(),
-                result.as_os_str(),
-                "--generator".as_ref(),
-                script.as_os_str(),
-            ],
-        );
-        let report: Value = std::fs::read_to_string(&result)
-            .ok()
-            .and_then(|t| serde_json::from_str(&t).ok())
-            .unwrap_or(Value::Null);
-        assert!(
-            run.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
-            "Blender {label}: check_generated failed\nfailures: {}\nstdout:\n{}\nstderr:\n{}",
-            report["failures"],
-            String::from_utf8_lossy(&run.stdout),
-            String::from_utf8_lossy(&run.stderr)
-        );
-    }
+    let expect = dir.path().join("expect.json");
+    std::fs::write(&expect, expectations(preset).to_string()).unwrap();
+    let result = dir.path().join("result.json");
+    let run = common::blender::run_in_blender(
+        &blender,
+        checker.as_ref(),
+        &[
+            "--blend".as_ref(),
+            blend.as_os_str(),
+            "--expect".as_ref(),
+            expect.as_os_str(),
+            "--out".as_ref(),
+            result.as_os_str(),
+            "--generator".as_ref(),
+            script.as_os_str(),
+        ],
+    );
+    let report: Value = std::fs::read_to_string(&result)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(Value::Null);
+    assert!(
+        run.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
+        "Blender {label}: check_generated failed\nfailures: {}\nstdout:\n{}\nstderr:\n{}",
+        report["failures"],
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
 }
+
+common::blender::per_blender!(generated_blend_works_in_every_blender);
 
 #[test]
 fn into_replaces_groups_in_place_and_keeps_a_backup() {
@@ -310,7 +312,8 @@ fn into_replaces_groups_in_place_and_keeps_a_backup() {
 
 /// The extension built in bpy 4.5: Blender's validator accepts it, and in bpy 4.5 and 5.0
 /// it installs, enables, registers its library with the generated groups, and cleans up
-/// on disable (tests/blender/check_extension.py, in a fresh user-resources folder).
+/// on disable (tests/blender/check_extension.py, in a fresh user-resources folder). One
+/// test, not one per version: the one extension bpy 4.5 built is what each Blender installs.
 #[test]
 fn the_extension_installs_and_brings_the_groups() {
     let Some(builder) = common::blender::real_blender("4.5") else {
@@ -403,97 +406,110 @@ fn blender_3_4_cannot_build_an_extension() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
+/// The script `generate --mode view --script` writes without any Blender, and the groups its
+/// summary names: made once for the per-version tests (in cargo's temporary folder for tests,
+/// since a static is never dropped).
+fn view_script() -> &'static (PathBuf, Vec<String>) {
+    static SCRIPT: OnceLock<(PathBuf, Vec<String>)> = OnceLock::new();
+    SCRIPT.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("one-script");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let script = dir.join("gloffuse.py");
+        let out = common::gloffuse()
+            .args(["generate", "--mode", "view", "--json", "--script"])
+            .arg(&script)
+            .env("GLOFFUSE_BLENDER", "/nonexistent/blender")
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        let summary: Value = serde_json::from_slice(&out).unwrap();
+        let named: Vec<String> = summary["groups"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|g| g.as_str().unwrap().to_string())
+            .collect();
+        assert!(
+            named.iter().any(|g| g == "Gloffuse View (GGX)"),
+            "{named:?}"
+        );
+        assert!(
+            !named.iter().any(|g| g.contains("Multiscatter")),
+            "{named:?}"
+        );
+        (script, named)
+    })
+}
+
 /// One script, written without any Blender, run in Blender 3.4, 4.5 and 5.0: each builds
 /// the groups of its own masking family (3.4 the blender-3 curves, 4.5 and 5.0 the
 /// blender-4 ones), measured through Cycles by check_generated.py; and `--mode view` alone
 /// builds the view groups and not the multiscatter ones, exactly the groups the summary names.
-#[test]
-fn one_script_serves_every_blender() {
+fn one_script_serves_every_blender(label: &'static str, blender: PathBuf) {
     let checker = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/tests/blender/check_generated.py"
     );
+    let (script, named) = view_script();
     let dir = tempfile::tempdir().unwrap();
-    let script = dir.path().join("gloffuse.py");
-    let out = common::gloffuse()
-        .args(["generate", "--mode", "view", "--json", "--script"])
-        .arg(&script)
-        .env("GLOFFUSE_BLENDER", "/nonexistent/blender")
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let summary: Value = serde_json::from_slice(&out).unwrap();
-    let named: Vec<&str> = summary["groups"]
+    let preset = if label == "3.4" {
+        "blender-3"
+    } else {
+        "blender-4"
+    };
+    let blend = dir.path().join(format!("groups-{label}.blend"));
+    let run =
+        common::blender::run_in_blender(&blender, script, &["--save".as_ref(), blend.as_os_str()]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "Blender {label}: {stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let result: Value = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("GLOFFUSE_RESULT "))
+        .map(|l| serde_json::from_str(l).unwrap())
+        .expect("a result line");
+    let built: Vec<&str> = result["groups"]
         .as_array()
         .unwrap()
         .iter()
         .map(|g| g.as_str().unwrap())
         .collect();
-    assert!(named.contains(&"Gloffuse View (GGX)"), "{named:?}");
-    assert!(
-        !named.iter().any(|g| g.contains("Multiscatter")),
-        "{named:?}"
+    assert_eq!(
+        built, *named,
+        "Blender {label} builds what the summary names"
     );
-    for (label, blender) in common::blender::real_blenders() {
-        let preset = if label == "3.4" {
-            "blender-3"
-        } else {
-            "blender-4"
-        };
-        let blend = dir.path().join(format!("groups-{label}.blend"));
-        let run = common::blender::run_in_blender(
-            &blender,
-            &script,
-            &["--save".as_ref(), blend.as_os_str()],
-        );
-        let stdout = String::from_utf8_lossy(&run.stdout);
-        assert!(
-            run.status.success(),
-            "Blender {label}: {stdout}{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let result: Value = stdout
-            .lines()
-            .rev()
-            .find_map(|l| l.strip_prefix("GLOFFUSE_RESULT "))
-            .map(|l| serde_json::from_str(l).unwrap())
-            .expect("a result line");
-        let built: Vec<&str> = result["groups"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|g| g.as_str().unwrap())
-            .collect();
-        assert_eq!(
-            built, named,
-            "Blender {label} builds what the summary names"
-        );
-        let expect = dir.path().join(format!("expect-{label}.json"));
-        std::fs::write(&expect, expectations(preset).to_string()).unwrap();
-        let report = dir.path().join(format!("report-{label}.json"));
-        let check = common::blender::run_in_blender(
-            &blender,
-            checker.as_ref(),
-            &[
-                "--blend".as_ref(),
-                blend.as_os_str(),
-                "--expect".as_ref(),
-                expect.as_os_str(),
-                "--out".as_ref(),
-                report.as_os_str(),
-            ],
-        );
-        let report: Value = std::fs::read_to_string(&report)
-            .ok()
-            .and_then(|t| serde_json::from_str(&t).ok())
-            .unwrap_or(Value::Null);
-        assert!(
-            check.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
-            "Blender {label}: the script's groups are not {preset}'s: {}\n{}",
-            report["failures"],
-            String::from_utf8_lossy(&check.stderr)
-        );
-    }
+    let expect = dir.path().join(format!("expect-{label}.json"));
+    std::fs::write(&expect, expectations(preset).to_string()).unwrap();
+    let report = dir.path().join(format!("report-{label}.json"));
+    let check = common::blender::run_in_blender(
+        &blender,
+        checker.as_ref(),
+        &[
+            "--blend".as_ref(),
+            blend.as_os_str(),
+            "--expect".as_ref(),
+            expect.as_os_str(),
+            "--out".as_ref(),
+            report.as_os_str(),
+        ],
+    );
+    let report: Value = std::fs::read_to_string(&report)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(Value::Null);
+    assert!(
+        check.status.success() && report["failures"].as_array().is_some_and(|f| f.is_empty()),
+        "Blender {label}: the script's groups are not {preset}'s: {}\n{}",
+        report["failures"],
+        String::from_utf8_lossy(&check.stderr)
+    );
 }
+
+common::blender::per_blender!(one_script_serves_every_blender);

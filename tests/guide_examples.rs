@@ -157,6 +157,9 @@ fn the_matcher_can_fail() {
     assert_eq!(parsed[2].command, "gloffuse w");
 }
 
+/// One test, not one per example: the examples run in order in one folder, a later one
+/// using what an earlier one wrote, so one example alone cannot run; the first to fail is
+/// named with its file and line.
 #[test]
 fn every_guide_example_runs_and_shows_what_the_guide_says() {
     let guide = std::fs::read_to_string(GUIDE).unwrap();

@@ -10,7 +10,7 @@
 mod common;
 
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn verify(blender: &Path, extra: &[&str]) -> (i32, Value) {
     common::verify_json(blender, &[&["--mode", "layered"], extra].concat())
@@ -27,62 +27,66 @@ fn name(r: &Value) -> String {
     )
 }
 
-#[test]
-fn a_white_layered_sphere_reflects_everything_and_the_mix_shader_is_predicted() {
-    for (label, blender) in common::blender::real_blenders() {
-        let (code, v) = verify(&blender, &[]);
-        assert_eq!(code, 0, "Blender {label}: {v:#}");
-        let rows = v["rows"].as_array().unwrap();
-        // 3 distributions × IOR {1.33, 1.5, 2} × r {0.1, 0.25, 0.5, 0.75, 1}.
-        assert_eq!(rows.len(), 45, "Blender {label}");
-        for r in rows {
-            assert!(
-                (f(&r["brightness"]) - 1.0).abs() <= 0.01 && f(&r["worst_ring"]) <= 0.015,
-                "Blender {label} {}: mean {} worst ring {}",
-                name(r),
-                r["brightness"],
-                r["worst_ring"]
-            );
-            // The Mix Shader is Blender's Fresnel node, Diffuse and Glossy; the prediction
-            // F E + (1 − F) is the integrator's. They agree to within the noise.
-            let (rendered, predicted) = (
-                f(&r["uncorrected_brightness"]),
-                f(&r["predicted_uncorrected"]),
-            );
-            assert!(
-                (rendered - predicted).abs() <= 0.004,
-                "Blender {label} {} Mix Shader: rendered {rendered} predicted {predicted}",
-                name(r)
-            );
-        }
-        // The hand-made Mix Shader loses energy where the layered group does not: GGX at
-        // IOR 2, r = 1 renders about 91 % (see docs/RESULTS.md's layered table).
-        let ggx = rows
-            .iter()
-            .find(|r| r["distribution"] == "ggx" && r["ior"] == 2.0 && r["roughness"] == 1.0)
-            .unwrap();
-        assert!(f(&ggx["uncorrected_brightness"]) < 0.93, "{ggx:#}");
-        let principled: Vec<f64> = v["reference"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .filter(|s| s["ior"] == 1.5)
-            .map(|s| f(&s["brightness"]))
-            .collect();
-        assert_eq!(principled.len(), 5);
-        if label == "3.4" {
-            // 3.4's Principled adds its diffuse base without taking off what the specular
-            // reflects: 105–109 % at IOR 1.5.
-            assert!(principled.iter().all(|&b| b > 1.03), "{principled:?}");
-        } else {
-            // 4.x/5.0's Principled layers by albedo scaling: the same 100 %.
-            assert!(
-                principled.iter().all(|&b| (b - 1.0).abs() < 0.01),
-                "{principled:?}"
-            );
-        }
+fn a_white_layered_sphere_reflects_everything_and_the_mix_shader_is_predicted(
+    label: &'static str,
+    blender: PathBuf,
+) {
+    let (code, v) = verify(&blender, &[]);
+    assert_eq!(code, 0, "Blender {label}: {v:#}");
+    let rows = v["rows"].as_array().unwrap();
+    // 3 distributions × IOR {1.33, 1.5, 2} × r {0.1, 0.25, 0.5, 0.75, 1}.
+    assert_eq!(rows.len(), 45, "Blender {label}");
+    for r in rows {
+        assert!(
+            (f(&r["brightness"]) - 1.0).abs() <= 0.01 && f(&r["worst_ring"]) <= 0.015,
+            "Blender {label} {}: mean {} worst ring {}",
+            name(r),
+            r["brightness"],
+            r["worst_ring"]
+        );
+        // The Mix Shader is Blender's Fresnel node, Diffuse and Glossy; the prediction
+        // F E + (1 − F) is the integrator's. They agree to within the noise.
+        let (rendered, predicted) = (
+            f(&r["uncorrected_brightness"]),
+            f(&r["predicted_uncorrected"]),
+        );
+        assert!(
+            (rendered - predicted).abs() <= 0.004,
+            "Blender {label} {} Mix Shader: rendered {rendered} predicted {predicted}",
+            name(r)
+        );
+    }
+    // The hand-made Mix Shader loses energy where the layered group does not: GGX at
+    // IOR 2, r = 1 renders about 91 % (see docs/RESULTS.md's layered table).
+    let ggx = rows
+        .iter()
+        .find(|r| r["distribution"] == "ggx" && r["ior"] == 2.0 && r["roughness"] == 1.0)
+        .unwrap();
+    assert!(f(&ggx["uncorrected_brightness"]) < 0.93, "{ggx:#}");
+    let principled: Vec<f64> = v["reference"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["ior"] == 1.5)
+        .map(|s| f(&s["brightness"]))
+        .collect();
+    assert_eq!(principled.len(), 5);
+    if label == "3.4" {
+        // 3.4's Principled adds its diffuse base without taking off what the specular
+        // reflects: 105–109 % at IOR 1.5.
+        assert!(principled.iter().all(|&b| b > 1.03), "{principled:?}");
+    } else {
+        // 4.x/5.0's Principled layers by albedo scaling: the same 100 %.
+        assert!(
+            principled.iter().all(|&b| (b - 1.0).abs() < 0.01),
+            "{principled:?}"
+        );
     }
 }
+
+common::blender::per_blender!(
+    a_white_layered_sphere_reflects_everything_and_the_mix_shader_is_predicted
+);
 
 /// Grey base 0.5 in Blender 4.5: every ring of `Gloffuse Layered (GGX)` within 2 % of
 /// Principled BSDF's ring at the same roughness and index.

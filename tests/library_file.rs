@@ -34,56 +34,58 @@ fn generate(blender: &Path, args: &[&std::ffi::OsStr]) -> assert_cmd::assert::As
 /// user's own `Gloffuse (GGX)`: the first renames it (and says so, in JSON and in text),
 /// the second has nothing to rename; the user's group keeps its nodes and its material,
 /// and the new group of that name is gloffuse's, tagged with the version.
-#[test]
-fn a_users_group_with_a_gloffuse_name_is_renamed_never_rebuilt() {
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let blend = dir.path().join("chair.blend");
-        make(&blender, &blend, &["--group", USER_GROUP]);
-        let into = ["--into".as_ref(), blend.as_os_str()];
-        let first = generate(&blender, &[&into[..], &["--json".as_ref()]].concat()).success();
-        let first: Value = serde_json::from_slice(&first.get_output().stdout).unwrap();
-        assert_eq!(
-            first["renamed"],
-            serde_json::json!([{"group": USER_GROUP, "renamed_to": "Gloffuse (GGX) (yours)"}]),
-            "Blender {label}: the first run names the rename"
-        );
-        // The second run: the text summary, which has nothing to rename.
-        let second = generate(&blender, &into).success();
-        let text = String::from_utf8_lossy(&second.get_output().stdout).to_string();
-        assert!(
-            text.contains("groups: ") && !text.contains("renamed:"),
-            "{text}"
-        );
+fn a_users_group_with_a_gloffuse_name_is_renamed_never_rebuilt(
+    label: &'static str,
+    blender: PathBuf,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let blend = dir.path().join("chair.blend");
+    make(&blender, &blend, &["--group", USER_GROUP]);
+    let into = ["--into".as_ref(), blend.as_os_str()];
+    let first = generate(&blender, &[&into[..], &["--json".as_ref()]].concat()).success();
+    let first: Value = serde_json::from_slice(&first.get_output().stdout).unwrap();
+    assert_eq!(
+        first["renamed"],
+        serde_json::json!([{"group": USER_GROUP, "renamed_to": "Gloffuse (GGX) (yours)"}]),
+        "Blender {label}: the first run names the rename"
+    );
+    // The second run: the text summary, which has nothing to rename.
+    let second = generate(&blender, &into).success();
+    let text = String::from_utf8_lossy(&second.get_output().stdout).to_string();
+    assert!(
+        text.contains("groups: ") && !text.contains("renamed:"),
+        "{text}"
+    );
 
-        let seen = inspect(&blender, &blend);
-        let yours = &seen["groups"]["Gloffuse (GGX) (yours)"];
-        assert_eq!(
-            yours["nodes"],
-            serde_json::json!(["Group Output", "user value"]),
-            "Blender {label}: the user's group keeps its nodes: {seen}"
-        );
-        assert!(yours["tag"].is_null(), "Blender {label}: {seen}");
-        assert_eq!(
-            seen["materials"]["Chair Paint"],
-            serde_json::json!(["Gloffuse (GGX) (yours)"]),
-            "Blender {label}: the material still uses the user's group"
-        );
-        let ours = &seen["groups"][USER_GROUP];
-        assert_eq!(ours["tag"], env!("CARGO_PKG_VERSION"), "{label}: {seen}");
-        assert!(
-            ours["nodes"]
-                .as_array()
-                .unwrap()
-                .contains(&"Glossy BSDF".into()),
-            "Blender {label}: the new group is gloffuse's: {seen}"
-        );
-        // Every group gloffuse made carries the tag; only the user's does not.
-        for (name, group) in seen["groups"].as_object().unwrap() {
-            assert_eq!(group["tag"].is_null(), name.ends_with("(yours)"), "{name}");
-        }
+    let seen = inspect(&blender, &blend);
+    let yours = &seen["groups"]["Gloffuse (GGX) (yours)"];
+    assert_eq!(
+        yours["nodes"],
+        serde_json::json!(["Group Output", "user value"]),
+        "Blender {label}: the user's group keeps its nodes: {seen}"
+    );
+    assert!(yours["tag"].is_null(), "Blender {label}: {seen}");
+    assert_eq!(
+        seen["materials"]["Chair Paint"],
+        serde_json::json!(["Gloffuse (GGX) (yours)"]),
+        "Blender {label}: the material still uses the user's group"
+    );
+    let ours = &seen["groups"][USER_GROUP];
+    assert_eq!(ours["tag"], env!("CARGO_PKG_VERSION"), "{label}: {seen}");
+    assert!(
+        ours["nodes"]
+            .as_array()
+            .unwrap()
+            .contains(&"Glossy BSDF".into()),
+        "Blender {label}: the new group is gloffuse's: {seen}"
+    );
+    // Every group gloffuse made carries the tag; only the user's does not.
+    for (name, group) in seen["groups"].as_object().unwrap() {
+        assert_eq!(group["tag"].is_null(), name.ends_with("(yours)"), "{name}");
     }
 }
+
+common::blender::per_blender!(a_users_group_with_a_gloffuse_name_is_renamed_never_rebuilt);
 
 /// The summary in text names the rename too (bpy 4.5).
 #[test]

@@ -12,6 +12,8 @@
 
 mod common;
 
+use std::path::PathBuf;
+
 use std::sync::Mutex;
 use std::time::Duration;
 
@@ -171,25 +173,24 @@ impl Progress for Notices {
     }
 }
 
-#[test]
-fn known_blenders_are_used_without_an_assumption_notice() {
-    for (label, program) in common::blender::real_blenders() {
-        let notices = Notices::default();
-        let options = BlenderOptions {
-            program: Some(program.clone()),
-            provision: false,
-            ..BlenderOptions::default()
-        };
-        let blender = options.find(&notices).unwrap();
-        assert!(!blender.version.is_newer_than_known(), "{label}");
-        let notices = notices.0.into_inner().unwrap();
-        assert!(
-            notices.iter().any(|n| n.starts_with("using Blender ")),
-            "{label}: {notices:?}"
-        );
-        assert!(
-            !notices.iter().any(|n| n.contains("newer than the newest")),
-            "{label}: {notices:?}"
-        );
-    }
+fn known_blenders_are_used_without_an_assumption_notice(label: &'static str, program: PathBuf) {
+    let notices = Notices::default();
+    let options = BlenderOptions {
+        program: Some(program.clone()),
+        provision: false,
+        ..BlenderOptions::default()
+    };
+    let blender = options.find(&notices).unwrap();
+    assert!(!blender.version.is_newer_than_known(), "{label}");
+    let notices = notices.0.into_inner().unwrap();
+    assert!(
+        notices.iter().any(|n| n.starts_with("using Blender ")),
+        "{label}: {notices:?}"
+    );
+    assert!(
+        !notices.iter().any(|n| n.contains("newer than the newest")),
+        "{label}: {notices:?}"
+    );
 }
+
+common::blender::per_blender!(known_blenders_are_used_without_an_assumption_notice);

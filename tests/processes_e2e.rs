@@ -85,63 +85,61 @@ fn temporaries_beside(file: &Path) -> Vec<String> {
 /// Case 2: bpy 4.5 used to save the file, print its result and then hang at interpreter
 /// exit until the timeout (600 s by default). Every Blender must finish well inside the
 /// 60 s timeout, exit 0, and leave the file changed with its backup beside it.
-#[test]
-fn a_python_driver_does_not_keep_blender_alive() {
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let file = dir.path().join("driven.blend");
-        driven_blend(&blender, &file);
-        let before = fs::read(&file).unwrap();
-        let start = Instant::now();
-        let out = generate_into(&blender, &file, &dir.path().join("cache"))
-            .output()
-            .unwrap();
-        let took = start.elapsed();
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "Blender {label}: {}",
-            text(&out)
-        );
-        assert!(took < Duration::from_secs(30), "Blender {label}: {took:?}");
-        assert_ne!(fs::read(&file).unwrap(), before, "Blender {label}");
-        assert!(temporaries_beside(&file).is_empty(), "Blender {label}");
-    }
+fn a_python_driver_does_not_keep_blender_alive(label: &'static str, blender: PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("driven.blend");
+    driven_blend(&blender, &file);
+    let before = fs::read(&file).unwrap();
+    let start = Instant::now();
+    let out = generate_into(&blender, &file, &dir.path().join("cache"))
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "Blender {label}: {}",
+        text(&out)
+    );
+    assert!(took < Duration::from_secs(30), "Blender {label}: {took:?}");
+    assert_ne!(fs::read(&file).unwrap(), before, "Blender {label}");
+    assert!(temporaries_beside(&file).is_empty(), "Blender {label}");
 }
+
+common::blender::per_blender!(a_python_driver_does_not_keep_blender_alive);
 
 /// Case 14: a folder named `Traceback (most recent call last):` holding the cache (so the
 /// script, its log and every path Blender prints) and the file does not fail the run: the
 /// log shows the words, and the run still succeeds by its exit status and result line. (A
 /// real exception in a job still fails, its traceback quoted: tests/blender_runner.rs,
 /// `real_*`.)
-#[test]
-fn a_folder_named_like_a_traceback_does_not_fail_a_run() {
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let odd = dir.path().join("Traceback (most recent call last):");
-        fs::create_dir(&odd).unwrap();
-        let file = odd.join("Error: scene.blend");
-        driven_blend(&blender, &file);
-        let cache = odd.join("cache");
-        let out = generate_into(&blender, &file, &cache).output().unwrap();
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "Blender {label}: {}",
-            text(&out)
-        );
-        let runs: Vec<PathBuf> = fs::read_dir(cache.join("gloffuse/runs"))
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .collect();
-        assert_eq!(runs.len(), 1, "{runs:?}");
-        let log = fs::read_to_string(runs[0].join("blender.log")).unwrap();
-        assert!(
-            log.contains("Traceback (most recent call last)"),
-            "Blender {label}: the log should name the folder:\n{log}"
-        );
-    }
+fn a_folder_named_like_a_traceback_does_not_fail_a_run(label: &'static str, blender: PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let odd = dir.path().join("Traceback (most recent call last):");
+    fs::create_dir(&odd).unwrap();
+    let file = odd.join("Error: scene.blend");
+    driven_blend(&blender, &file);
+    let cache = odd.join("cache");
+    let out = generate_into(&blender, &file, &cache).output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "Blender {label}: {}",
+        text(&out)
+    );
+    let runs: Vec<PathBuf> = fs::read_dir(cache.join("gloffuse/runs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(runs.len(), 1, "{runs:?}");
+    let log = fs::read_to_string(runs[0].join("blender.log")).unwrap();
+    assert!(
+        log.contains("Traceback (most recent call last)"),
+        "Blender {label}: the log should name the folder:\n{log}"
+    );
 }
+
+common::blender::per_blender!(a_folder_named_like_a_traceback_does_not_fail_a_run);
 
 /// The child of `pid` running the generate script (not a version probe), if any (Linux).
 fn script_child(pid: u32) -> Option<u32> {
@@ -158,55 +156,51 @@ fn script_child(pid: u32) -> Option<u32> {
 /// Case 12: SIGTERM (`timeout`, a CI cancel) and SIGHUP while Blender works on the user's
 /// file: gloffuse stops Blender (its whole process group), exits 128 + the signal, and the
 /// file is byte-identical, with neither a backup nor a temporary file beside it.
-#[test]
-fn sigterm_and_sighup_stop_blender_and_leave_the_file_alone() {
-    for label in ["4.5", "3.4"] {
-        let Some(blender) = common::blender::real_blender(label) else {
-            continue;
+fn sigterm_and_sighup_stop_blender_and_leave_the_file_alone(label: &'static str, blender: PathBuf) {
+    for (signal, code) in [(libc::SIGTERM, 143), (libc::SIGHUP, 129)] {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("scene.blend");
+        driven_blend(&blender, &file);
+        let before = fs::read(&file).unwrap();
+        let child = generate_into(&blender, &file, &dir.path().join("cache"))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let pid = child.id();
+        let deadline = Instant::now() + Duration::from_secs(30);
+        let blender_pid = loop {
+            if let Some(p) = script_child(pid) {
+                break p;
+            }
+            assert!(Instant::now() < deadline, "Blender {label} never started");
+            std::thread::sleep(Duration::from_millis(20));
         };
-        for (signal, code) in [(libc::SIGTERM, 143), (libc::SIGHUP, 129)] {
-            let dir = tempfile::tempdir().unwrap();
-            let file = dir.path().join("scene.blend");
-            driven_blend(&blender, &file);
-            let before = fs::read(&file).unwrap();
-            let child = generate_into(&blender, &file, &dir.path().join("cache"))
-                .stdout(Stdio::piped())
-                .stderr(Stdio::piped())
-                .spawn()
-                .unwrap();
-            let pid = child.id();
-            let deadline = Instant::now() + Duration::from_secs(30);
-            let blender_pid = loop {
-                if let Some(p) = script_child(pid) {
-                    break p;
-                }
-                assert!(Instant::now() < deadline, "Blender {label} never started");
-                std::thread::sleep(Duration::from_millis(20));
-            };
-            // Freeze Blender mid-run so the signal cannot lose a race with a fast job (a
-            // 400 ms pause once let bpy 4.5 finish first on CI); gloffuse must still stop
-            // a stopped group.
-            // SAFETY: killpg only sends a signal to the group of the Blender we found.
-            assert_eq!(
-                unsafe { libc::killpg(blender_pid as libc::pid_t, libc::SIGSTOP) },
-                0,
-                "Blender {label} ended before it could be frozen"
-            );
-            // SAFETY: kill only sends a signal to the child we spawned.
-            assert_eq!(unsafe { libc::kill(pid as libc::pid_t, signal) }, 0);
-            let out = child.wait_with_output().unwrap();
-            let what = format!("Blender {label}, signal {signal}: {}", text(&out));
-            assert_eq!(out.status.code(), Some(code), "{what}");
-            assert!(text(&out).contains("interrupted"), "{what}");
-            assert_eq!(fs::read(&file).unwrap(), before, "{what}");
-            assert!(temporaries_beside(&file).is_empty(), "{what}");
-            assert!(!dir.path().join("scene.blend1").exists(), "{what}");
-            // SAFETY: signal 0 only asks whether the process group exists.
-            let alive = unsafe { libc::killpg(blender_pid as libc::pid_t, 0) } == 0;
-            assert!(!alive, "{what}: Blender's group outlived gloffuse");
-        }
+        // Freeze Blender mid-run so the signal cannot lose a race with a fast job (a
+        // 400 ms pause once let bpy 4.5 finish first on CI); gloffuse must still stop
+        // a stopped group.
+        // SAFETY: killpg only sends a signal to the group of the Blender we found.
+        assert_eq!(
+            unsafe { libc::killpg(blender_pid as libc::pid_t, libc::SIGSTOP) },
+            0,
+            "Blender {label} ended before it could be frozen"
+        );
+        // SAFETY: kill only sends a signal to the child we spawned.
+        assert_eq!(unsafe { libc::kill(pid as libc::pid_t, signal) }, 0);
+        let out = child.wait_with_output().unwrap();
+        let what = format!("Blender {label}, signal {signal}: {}", text(&out));
+        assert_eq!(out.status.code(), Some(code), "{what}");
+        assert!(text(&out).contains("interrupted"), "{what}");
+        assert_eq!(fs::read(&file).unwrap(), before, "{what}");
+        assert!(temporaries_beside(&file).is_empty(), "{what}");
+        assert!(!dir.path().join("scene.blend1").exists(), "{what}");
+        // SAFETY: signal 0 only asks whether the process group exists.
+        let alive = unsafe { libc::killpg(blender_pid as libc::pid_t, 0) } == 0;
+        assert!(!alive, "{what}: Blender's group outlived gloffuse");
     }
 }
+
+common::blender::per_blender!(sigterm_and_sighup_stop_blender_and_leave_the_file_alone: in_blender_3_4, in_blender_4_5);
 
 /// `gloffuse ARGS` with a stdout whose reader is already gone (`… | true`): its exit code.
 fn with_closed_stdout(args: &[&str], blender: &Path) -> (i32, String) {

@@ -11,6 +11,8 @@
 
 mod common;
 
+use std::path::PathBuf;
+
 use std::sync::Mutex;
 
 use gloffuse::blender::{BlenderOptions, probe};
@@ -105,41 +107,43 @@ fn generate_tells_each_group_preview_and_the_save() {
     assert_eq!(*steps, (0..total).collect::<Vec<_>>(), "{doing:?}");
 }
 
-#[test]
-fn the_verify_render_follows_cycles_estimate_in_every_blender() {
-    for (label, program) in common::blender::real_blenders() {
-        let blender = probe(&program).unwrap();
-        let mut options = VerifyOptions {
-            distributions: vec![Distribution::Ggx],
-            roughness: [0.3, 0.7].map(|r| Roughness::new(r).unwrap()).to_vec(),
-            ..VerifyOptions::default()
-        };
-        // Long enough that the watcher (every 200 ms) sees a line between the first
-        // sample and the last.
-        options.render.samples = 512;
-        let recorded = Recorded::default();
-        verify_with(&blender, &options, &recorded).unwrap();
+fn the_verify_render_follows_cycles_estimate_in_every_blender(
+    label: &'static str,
+    program: PathBuf,
+) {
+    let blender = probe(&program).unwrap();
+    let mut options = VerifyOptions {
+        distributions: vec![Distribution::Ggx],
+        roughness: [0.3, 0.7].map(|r| Roughness::new(r).unwrap()).to_vec(),
+        ..VerifyOptions::default()
+    };
+    // Long enough that the watcher (every 200 ms) sees a line between the first
+    // sample and the last.
+    options.render.samples = 512;
+    let recorded = Recorded::default();
+    verify_with(&blender, &options, &recorded).unwrap();
 
-        let begun = recorded.begun.lock().unwrap();
-        assert_eq!(begun.len(), 1, "Blender {label}: {begun:?}");
-        assert!(begun[0].starts_with("rendering"), "{begun:?}");
-        let estimates = recorded.estimates.lock().unwrap();
-        let with_cycles_estimate: Vec<_> = estimates
-            .iter()
-            .filter(|(done, left)| *done < 1.0 && left.is_some_and(|s| s > 0.0))
-            .collect();
+    let begun = recorded.begun.lock().unwrap();
+    assert_eq!(begun.len(), 1, "Blender {label}: {begun:?}");
+    assert!(begun[0].starts_with("rendering"), "{begun:?}");
+    let estimates = recorded.estimates.lock().unwrap();
+    let with_cycles_estimate: Vec<_> = estimates
+        .iter()
+        .filter(|(done, left)| *done < 1.0 && left.is_some_and(|s| s > 0.0))
+        .collect();
+    assert!(
+        !with_cycles_estimate.is_empty(),
+        "Blender {label}: no estimate from Cycles' Remaining was seen: {estimates:?}"
+    );
+    for pair in estimates.windows(2) {
         assert!(
-            !with_cycles_estimate.is_empty(),
-            "Blender {label}: no estimate from Cycles' Remaining was seen: {estimates:?}"
+            pair[1].0 >= pair[0].0,
+            "Blender {label}: the bar went back: {pair:?}"
         );
-        for pair in estimates.windows(2) {
-            assert!(
-                pair[1].0 >= pair[0].0,
-                "Blender {label}: the bar went back: {pair:?}"
-            );
-        }
-        for (done, _) in estimates.iter() {
-            assert!((0.0..=1.0).contains(done), "Blender {label}: {done}");
-        }
+    }
+    for (done, _) in estimates.iter() {
+        assert!((0.0..=1.0).contains(done), "Blender {label}: {done}");
     }
 }
+
+common::blender::per_blender!(the_verify_render_follows_cycles_estimate_in_every_blender);

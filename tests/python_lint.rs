@@ -5,9 +5,11 @@
 //!
 //! ruff comes from `$GLOFFUSE_TEST_RUFF`, which `scripts/test.sh` sets after installing
 //! ruff from PyPI. Unset, the test fails, unless `GLOFFUSE_SKIP_RUFF_TESTS=1` is set:
-//! then it says what it skipped and passes.
+//! then it records the skip (`common::skip`) and passes.
 //!
 //! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
+
+mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -19,15 +21,14 @@ const SKIP_VAR: &str = "GLOFFUSE_SKIP_RUFF_TESTS";
 const RUFF_VAR: &str = "GLOFFUSE_TEST_RUFF";
 
 fn ruff() -> Option<PathBuf> {
-    let skip = std::env::var_os(SKIP_VAR).is_some_and(|v| v == "1");
     let why = match std::env::var_os(RUFF_VAR) {
         Some(path) if Path::new(&path).exists() => return Some(path.into()),
         Some(path) => format!("ruff: {} not found", Path::new(&path).display()),
         None => format!("ruff: {RUFF_VAR} is not set (run scripts/test.sh, which installs it)"),
     };
-    assert!(skip, "{why}; set {SKIP_VAR}=1 to skip the Python lint");
-    eprintln!(
-        "skipped ({SKIP_VAR}=1): {why}; not checked: blender/, tests/blender/ and the bundled scripts"
+    common::skip(
+        SKIP_VAR,
+        &format!("{why}; not checked: blender/, tests/blender/ and the bundled scripts"),
     );
     None
 }

@@ -123,3 +123,49 @@ fn bpy_4_5_is_shared_with_gloffuse_not_downloaded_twice() {
     assert_eq!(std::fs::read_link(&main).unwrap(), venv);
     assert_eq!(std::fs::read_link(&test).unwrap(), venv);
 }
+
+/// `cargo_test` hands cargo a fresh `$GLOFFUSE_TEST_SKIPS` file, lists what the tests wrote
+/// into it after cargo's own summary (which counts a skip as `ok`), removes it, and returns
+/// cargo's exit status unchanged; with no skips it adds nothing. (A stand-in `cargo` writes
+/// the lines `common::skip` writes.)
+#[test]
+fn the_summary_lists_the_skipped_tests_and_keeps_cargos_status() {
+    let tmp = tempfile::tempdir().unwrap();
+    let env = [("TMPDIR", tmp.path())];
+    let skipping = r#"cargo() {
+        echo "ARGS $*"
+        echo "verify_e2e::sweeps::in_blender_5_0: Blender 5.0: /nope not found" >>"$GLOFFUSE_TEST_SKIPS"
+        echo "python_lint::lint: ruff: GLOFFUSE_TEST_RUFF is not set" >>"$GLOFFUSE_TEST_SKIPS"
+        return 101
+    }
+    cargo_test --locked --test verify_e2e || echo "STATUS $?""#;
+    let out = run(skipping, &env);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        stdout.contains("ARGS test --locked --test verify_e2e\n"),
+        "{stdout}"
+    );
+    let summary = stdout
+        .split_once("== skipped: 2 tests")
+        .unwrap_or_else(|| panic!("no summary: {stdout}"))
+        .1;
+    let lines: Vec<&str> = summary.lines().skip(1).map(str::trim).collect();
+    assert_eq!(
+        lines,
+        [
+            "python_lint::lint: ruff: GLOFFUSE_TEST_RUFF is not set",
+            "verify_e2e::sweeps::in_blender_5_0: Blender 5.0: /nope not found",
+            "STATUS 101",
+        ],
+        "{stdout}"
+    );
+    assert_eq!(
+        std::fs::read_dir(tmp.path()).unwrap().count(),
+        0,
+        "left behind"
+    );
+
+    let out = run("cargo() { :; }; cargo_test; echo \"STATUS $?\"", &env);
+    assert_eq!(text(&out.stdout), "STATUS 0\n");
+}

@@ -290,39 +290,38 @@ fn a_file_saved_by_another_program_meanwhile_is_left_as_it_saved_it() {
 /// lossy spelling (U+FFFD). In every Blender, the file itself is audited and fixed in
 /// place; the sibling is untouched (before, the sibling was audited and its fixed copy
 /// replaced the real file).
-#[test]
-fn a_name_that_is_not_utf8_reaches_blender_byte_for_byte() {
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let cache = tempfile::tempdir().unwrap();
-        let made = dir.path().join("made.blend");
-        fixable(&blender, &made);
-        let raw = dir.path().join(OsStr::from_bytes(b"caf\xe9 scene.blend"));
-        let sibling = dir.path().join("caf\u{FFFD} scene.blend");
-        fs::rename(&made, &raw).unwrap();
-        common::user_file::make(&blender, &sibling, &[]);
-        let (raw_before, sibling_before) = (fs::read(&raw).unwrap(), fs::read(&sibling).unwrap());
-        let out = finish(
-            audit(
-                &blender,
-                cache.path(),
-                &[raw.as_os_str(), "--in-place".as_ref()],
-            )
-            .spawn()
-            .unwrap(),
-        );
-        let what = format!("Blender {label}: {}", text(&out));
-        assert_eq!(fs::read(&sibling).unwrap(), sibling_before, "{what}");
-        let mut backup = raw.clone().into_os_string();
-        backup.push("1");
-        assert_eq!(fs::read(&backup).unwrap(), raw_before, "{what}");
-        let report: Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(report["files"][0]["fixed"]["replaced"], 1, "{what}");
-        // The fixed file is audited again: nothing is left to replace.
-        assert_eq!(report["materials"][0]["after"]["verdict"], "ok", "{what}");
-        assert!(leftovers(dir.path()).is_empty(), "{what}");
-    }
+fn a_name_that_is_not_utf8_reaches_blender_byte_for_byte(label: &'static str, blender: PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = tempfile::tempdir().unwrap();
+    let made = dir.path().join("made.blend");
+    fixable(&blender, &made);
+    let raw = dir.path().join(OsStr::from_bytes(b"caf\xe9 scene.blend"));
+    let sibling = dir.path().join("caf\u{FFFD} scene.blend");
+    fs::rename(&made, &raw).unwrap();
+    common::user_file::make(&blender, &sibling, &[]);
+    let (raw_before, sibling_before) = (fs::read(&raw).unwrap(), fs::read(&sibling).unwrap());
+    let out = finish(
+        audit(
+            &blender,
+            cache.path(),
+            &[raw.as_os_str(), "--in-place".as_ref()],
+        )
+        .spawn()
+        .unwrap(),
+    );
+    let what = format!("Blender {label}: {}", text(&out));
+    assert_eq!(fs::read(&sibling).unwrap(), sibling_before, "{what}");
+    let mut backup = raw.clone().into_os_string();
+    backup.push("1");
+    assert_eq!(fs::read(&backup).unwrap(), raw_before, "{what}");
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["files"][0]["fixed"]["replaced"], 1, "{what}");
+    // The fixed file is audited again: nothing is left to replace.
+    assert_eq!(report["materials"][0]["after"]["verdict"], "ok", "{what}");
+    assert!(leftovers(dir.path()).is_empty(), "{what}");
 }
+
+common::blender::per_blender!(a_name_that_is_not_utf8_reaches_blender_byte_for_byte);
 
 /// Case 4: `--fix-dir` with two inputs of one relative name is refused before Blender
 /// starts, naming both (before, the second fixed copy silently replaced the first).

@@ -8,6 +8,8 @@
 
 mod common;
 
+use std::path::PathBuf;
+
 use serde_json::Value;
 
 fn verify_json(blender: &std::path::Path, extra: &[&str]) -> (i32, Value, String) {
@@ -24,76 +26,75 @@ fn verify_json(blender: &std::path::Path, extra: &[&str]) -> (i32, Value, String
     (out.status.code().unwrap_or(-1), v, stderr)
 }
 
-#[test]
-fn default_coefficients_pass_in_every_blender() {
-    for (label, blender) in common::blender::real_blenders() {
-        let dir = tempfile::tempdir().unwrap();
-        let report = dir.path().join("report dir é");
-        let (code, v, stderr) =
-            verify_json(&blender, &["--json", "--report", report.to_str().unwrap()]);
-        assert_eq!(code, 0, "Blender {label}: {stderr}\n{v:#}");
-        assert_eq!(v["pass"], true);
+fn default_coefficients_pass_in_every_blender(label: &'static str, blender: PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report dir é");
+    let (code, v, stderr) =
+        verify_json(&blender, &["--json", "--report", report.to_str().unwrap()]);
+    assert_eq!(code, 0, "Blender {label}: {stderr}\n{v:#}");
+    assert_eq!(v["pass"], true);
+    assert!(
+        v["render"]["blender_version"]
+            .as_str()
+            .unwrap()
+            .starts_with(label)
+    );
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 33, "3 distributions × 11 roughness values");
+    // The preset of this Blender: nothing to note.
+    assert_eq!(v["notes"], serde_json::json!([]), "Blender {label}");
+    for (i, r) in rows.iter().enumerate() {
+        // Rows are numbered in order; roughness is a plain number.
+        assert_eq!(r["id"].as_u64(), Some(i as u64), "Blender {label}");
         assert!(
-            v["render"]["blender_version"]
-                .as_str()
-                .unwrap()
-                .starts_with(label)
+            r["roughness"].is_f64(),
+            "Blender {label}: {}",
+            r["roughness"]
         );
-        let rows = v["rows"].as_array().unwrap();
-        assert_eq!(rows.len(), 33, "3 distributions × 11 roughness values");
-        // The preset of this Blender: nothing to note.
-        assert_eq!(v["notes"], serde_json::json!([]), "Blender {label}");
-        for (i, r) in rows.iter().enumerate() {
-            // Rows are numbered in order; roughness is a plain number.
-            assert_eq!(r["id"].as_u64(), Some(i as u64), "Blender {label}");
-            assert!(
-                r["roughness"].is_f64(),
-                "Blender {label}: {}",
-                r["roughness"]
-            );
-            let what = format!("Blender {label} {} r={}", r["distribution"], r["roughness"]);
-            let corrected = r["corrected"]["mean"].as_f64().unwrap();
-            assert!(
-                (corrected - 1.0).abs() <= 0.01,
-                "{what}: corrected {corrected}"
-            );
-            // Render vs integrator, uncorrected: two independent routes to E_avg.
-            let rendered = r["uncorrected"]["mean"].as_f64().unwrap();
-            let predicted = r["predicted_uncorrected"].as_f64().unwrap();
-            assert!(
-                (rendered / predicted - 1.0).abs() < 0.005,
-                "{what}: rendered {rendered}, predicted {predicted}"
-            );
-            assert!(
-                r["corrected"]["standard_error"].as_f64().unwrap() <= 0.002,
-                "{what}: standard error"
-            );
-        }
-        for m in v["reference"].as_array().unwrap() {
-            let mean = m["stats"]["mean"].as_f64().unwrap();
-            assert!(
-                (mean - 1.0).abs() < 0.01,
-                "Blender {label}: Multiscatter GGX {mean}"
-            );
-        }
-        for name in [
-            "report.json",
-            "sweep.exr",
-            "contact-sheet.png",
-            "brightness.png",
-        ] {
-            let p = report.join(name);
-            assert!(
-                std::fs::metadata(&p).map(|m| m.len() > 0).unwrap_or(false),
-                "{}",
-                p.display()
-            );
-        }
-        // The report's EXR reads back with the same statistics the report holds.
-        let img = gloffuse::verify::image::read_rgba(&report.join("sweep.exr")).unwrap();
-        assert_eq!((img.width, img.height), (11 * 64, 7 * 64));
+        let what = format!("Blender {label} {} r={}", r["distribution"], r["roughness"]);
+        let corrected = r["corrected"]["mean"].as_f64().unwrap();
+        assert!(
+            (corrected - 1.0).abs() <= 0.01,
+            "{what}: corrected {corrected}"
+        );
+        // Render vs integrator, uncorrected: two independent routes to E_avg.
+        let rendered = r["uncorrected"]["mean"].as_f64().unwrap();
+        let predicted = r["predicted_uncorrected"].as_f64().unwrap();
+        assert!(
+            (rendered / predicted - 1.0).abs() < 0.005,
+            "{what}: rendered {rendered}, predicted {predicted}"
+        );
+        assert!(
+            r["corrected"]["standard_error"].as_f64().unwrap() <= 0.002,
+            "{what}: standard error"
+        );
     }
+    for m in v["reference"].as_array().unwrap() {
+        let mean = m["stats"]["mean"].as_f64().unwrap();
+        assert!(
+            (mean - 1.0).abs() < 0.01,
+            "Blender {label}: Multiscatter GGX {mean}"
+        );
+    }
+    for name in [
+        "report.json",
+        "sweep.exr",
+        "contact-sheet.png",
+        "brightness.png",
+    ] {
+        let p = report.join(name);
+        assert!(
+            std::fs::metadata(&p).map(|m| m.len() > 0).unwrap_or(false),
+            "{}",
+            p.display()
+        );
+    }
+    // The report's EXR reads back with the same statistics the report holds.
+    let img = gloffuse::verify::image::read_rgba(&report.join("sweep.exr")).unwrap();
+    assert_eq!((img.width, img.height), (11 * 64, 7 * 64));
 }
+
+common::blender::per_blender!(default_coefficients_pass_in_every_blender);
 
 #[test]
 fn seed_coefficients_fail_and_say_why() {
@@ -442,10 +443,8 @@ fn label(distribution: &Value) -> &'static str {
 /// Blender (never a flag), and the command line adds the flag that checks with it.
 #[test]
 fn masking_mismatch_names_the_preset_and_the_cli_the_flag() {
-    let Some((label, blender)) = common::blender::real_blenders()
-        .into_iter()
-        .find(|(l, _)| *l == "3.4")
-    else {
+    let label = "3.4";
+    let Some(blender) = common::blender::real_blender(label) else {
         return;
     };
     let args = ["--coefficients", "blender-4", "-r", "1", "-d", "ggx"];

@@ -2,7 +2,8 @@
 //!
 //! Each Blender comes from an environment variable that `scripts/test.sh` sets, else from
 //! where that script installs it. A missing one fails the test, unless
-//! `GLOFFUSE_SKIP_BLENDER_TESTS=1` is set: then the test says what it skipped and passes.
+//! `GLOFFUSE_SKIP_BLENDER_TESTS=1` is set: then the test records the skip and passes. A test
+//! about one Blender is stamped once per version by [`per_blender`].
 
 use std::path::{Path, PathBuf};
 
@@ -24,55 +25,93 @@ fn test_cache() -> PathBuf {
     cache.join("gloffuse").join("test-blenders")
 }
 
-/// The real Blenders, as (label, program): 3.4 (Debian's binary), bpy 4.5 and bpy 5.0.
-pub fn real_blenders() -> Vec<(&'static str, PathBuf)> {
-    let cache = test_cache();
-    let known = [
-        (
-            "3.4",
+/// The real Blenders' labels, oldest first.
+pub const LABELS: [&str; 3] = ["3.4", "4.5", "5.0"];
+
+/// The real Blender labelled `label` (`"3.4"`: Debian's binary, `"4.5"`, `"5.0"`: bpy), from
+/// its variable, else where `scripts/test.sh` installs it. A missing one fails the test
+/// unless skipping was asked for ([`SKIP_VAR`], [`super::skip`]): then `None`.
+pub fn real_blender(label: &str) -> Option<PathBuf> {
+    let (var, default) = match label {
+        "3.4" => (
             "GLOFFUSE_TEST_BLENDER_34",
             PathBuf::from("/usr/bin/blender"),
         ),
-        (
-            "4.5",
+        "4.5" => (
             "GLOFFUSE_TEST_BPY_45",
-            cache.join("bpy-4.5/bin/python"),
+            test_cache().join("bpy-4.5/bin/python"),
         ),
-        (
-            "5.0",
+        "5.0" => (
             "GLOFFUSE_TEST_BPY_50",
-            cache.join("bpy-5.0/bin/python"),
+            test_cache().join("bpy-5.0/bin/python"),
         ),
-    ];
-    let skip = std::env::var_os(SKIP_VAR).is_some_and(|v| v == "1");
-    let mut found = Vec::new();
-    for (label, var, default) in known {
-        let path = std::env::var_os(var).map_or(default, PathBuf::from);
-        if path.exists() {
-            found.push((label, path));
-            continue;
-        }
-        let why = format!(
-            "Blender {label}: {} not found (set {var}, or run scripts/test.sh)",
-            path.display()
-        );
-        assert!(
-            skip,
-            "{why}; set {SKIP_VAR}=1 to skip the tests that need it"
-        );
-        eprintln!("skipped ({SKIP_VAR}=1): {why}");
+        other => panic!("no real Blender is labelled {other}"),
+    };
+    let path = std::env::var_os(var).map_or(default, PathBuf::from);
+    if path.exists() {
+        return Some(path);
     }
-    found
+    let why = format!(
+        "Blender {label}: {} not found (set {var}, or run scripts/test.sh)",
+        path.display()
+    );
+    super::skip(SKIP_VAR, &why);
+    None
 }
 
-/// The real Blender labelled `label` (`"3.4"`, `"4.5"`, `"5.0"`), under the rules of
-/// [`real_blenders`]: `None` only when it is missing and skipping was asked for.
-pub fn real_blender(label: &str) -> Option<PathBuf> {
-    real_blenders()
+/// Every real Blender found, as (label, program), under the rules of [`real_blender`]: for
+/// the tests that compare the versions, where one missing leaves the others to compare.
+/// Every other test runs once per version ([`per_blender`]).
+pub fn real_blenders() -> Vec<(&'static str, PathBuf)> {
+    LABELS
         .into_iter()
-        .find(|(l, _)| *l == label)
-        .map(|(_, path)| path)
+        .filter_map(|label| Some((label, real_blender(label)?)))
+        .collect()
 }
+
+/// The label of a test stamped by [`per_blender`], from its name.
+pub fn label_of(test: &str) -> &'static str {
+    match test {
+        "in_blender_3_4" => "3.4",
+        "in_blender_4_5" => "4.5",
+        "in_blender_5_0" => "5.0",
+        other => panic!("{other} names no real Blender"),
+    }
+}
+
+/// `per_blender!(NAME)` stamps one `#[test]` per real Blender for `fn NAME(label: &'static
+/// str, blender: PathBuf)`: a module `NAME` holding `in_blender_3_4`, `in_blender_4_5` and
+/// `in_blender_5_0`, each calling `NAME` with its Blender (skipped as [`real_blender`]
+/// says), so one failing version hides no other. `per_blender!(NAME: in_blender_4_5, …)`
+/// stamps only those listed; attributes before `NAME` (`#[ignore]`) go on every test.
+#[allow(unused_macros)]
+macro_rules! per_blender {
+    (@test [$($attr:tt)*] $name:ident $test:ident) => {
+        #[test]
+        $($attr)*
+        fn $test() {
+            let label = $crate::common::blender::label_of(stringify!($test));
+            if let Some(blender) = $crate::common::blender::real_blender(label) {
+                super::$name(label, blender);
+            }
+        }
+    };
+    ($(#[$attr:meta])* $name:ident) => {
+        $crate::common::blender::per_blender!(
+            $(#[$attr])* $name: in_blender_3_4, in_blender_4_5, in_blender_5_0
+        );
+    };
+    ($(#[$attr:meta])* $name:ident: $($test:ident),+) => {
+        $crate::common::blender::per_blender!(@tests [$(#[$attr])*] $name: $($test),+);
+    };
+    (@tests $attrs:tt $name:ident: $($test:ident),+) => {
+        mod $name {
+            $($crate::common::blender::per_blender!(@test $attrs $name $test);)+
+        }
+    };
+}
+#[allow(unused_imports)]
+pub(crate) use per_blender;
 
 /// Runs a Python file inside `blender` (an executable or a bpy Python) with script args,
 /// with the command line gloffuse itself uses (the library builds it).

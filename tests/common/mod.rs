@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests, one module per job: independent oracles
 //! (`oracle`), real Blenders (`blender`), a user's own .blend (`user_file`), the audit's
-//! library of user materials and its expectations (`audit_library`), and the binary itself
-//! ([`gloffuse`]).
+//! library of user materials and its expectations (`audit_library`), the binary itself
+//! ([`gloffuse`]), and skipping a test whose install is missing ([`skip`]).
 #![allow(dead_code)]
 
 pub mod audit_library;
@@ -52,7 +52,7 @@ pub fn audit_json(
 
 /// A headless browser for the report page: `$GLOFFUSE_TEST_CHROMIUM`, else Debian's
 /// `/usr/bin/chromium` (which `scripts/test.sh` installs). A missing one fails the test
-/// unless `GLOFFUSE_SKIP_BROWSER_TESTS=1`, and then the test says what it skipped.
+/// unless `GLOFFUSE_SKIP_BROWSER_TESTS=1` ([`skip`]).
 pub fn browser() -> Option<std::path::PathBuf> {
     let path = std::env::var_os("GLOFFUSE_TEST_CHROMIUM")
         .map_or_else(|| std::path::PathBuf::from("/usr/bin/chromium"), Into::into);
@@ -63,13 +63,40 @@ pub fn browser() -> Option<std::path::PathBuf> {
         "{} not found (set GLOFFUSE_TEST_CHROMIUM, or run scripts/test.sh)",
         path.display()
     );
-    let skip = std::env::var_os("GLOFFUSE_SKIP_BROWSER_TESTS").is_some_and(|v| v == "1");
-    assert!(
-        skip,
-        "{why}; set GLOFFUSE_SKIP_BROWSER_TESTS=1 to skip the browser check"
-    );
-    eprintln!("skipped (GLOFFUSE_SKIP_BROWSER_TESTS=1): {why}");
+    skip("GLOFFUSE_SKIP_BROWSER_TESTS", &why);
     None
+}
+
+/// Names the file `scripts/test.sh` collects the skips in, one line each, to list them in its
+/// summary (a skipped test passes as `ok`, so cargo's own summary cannot tell).
+pub const SKIPS_FILE_VAR: &str = "GLOFFUSE_TEST_SKIPS";
+
+/// The running test gives up because `why` (something `scripts/test.sh` installs is
+/// missing): allowed only when `skip_var` is `1`, else the test fails saying so.
+pub fn skip(skip_var: &str, why: &str) {
+    let asked = std::env::var_os(skip_var).is_some_and(|v| v == "1");
+    assert!(asked, "{why}; set {skip_var}=1 to skip");
+    record_skip(&format!("{why} ({skip_var}=1)"));
+}
+
+/// The running test gives up because of `why`: said on stderr, and `TEST: why` appended to
+/// `$GLOFFUSE_TEST_SKIPS` when set.
+pub fn record_skip(why: &str) {
+    eprintln!("skipped: {why}");
+    let Some(file) = std::env::var_os(SKIPS_FILE_VAR) else {
+        return;
+    };
+    // libtest runs each test in a thread named after it.
+    let thread = std::thread::current();
+    let test = thread.name().unwrap_or("?");
+    let line = format!("{}::{test}: {why}\n", env!("CARGO_CRATE_NAME"));
+    // One short write in append mode: the lines of parallel tests do not mix.
+    let mut skips = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&file)
+        .unwrap_or_else(|e| panic!("{SKIPS_FILE_VAR}: {e}"));
+    std::io::Write::write_all(&mut skips, line.as_bytes()).unwrap();
 }
 
 /// `page` as headless `chromium` draws it in a 1200 × 900 window.
