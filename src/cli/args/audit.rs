@@ -7,7 +7,11 @@ use super::blender::BlenderArgs;
 use super::parse::{parse_shard, parse_tolerance, parse_verdict};
 use gloffuse::audit::{AuditJudging, AuditOptions, FixTarget, Verdict};
 use gloffuse::shard::Shard;
-use gloffuse::verify::{RenderSettings, VerifyOptions};
+use gloffuse::verify::RenderSettings;
+
+fn audit_defaults() -> AuditOptions {
+    AuditOptions::default()
+}
 
 pub(super) const AUDIT_EXAMPLES: &str = "Examples:
   gloffuse audit assets/                         every .blend below assets/, a table
@@ -46,15 +50,15 @@ pub struct AuditArgs {
     pub no_render: bool,
 
     /// Pixels across each sphere's cell.
-    #[arg(long, default_value_t = VerifyOptions::default().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    #[arg(long, default_value_t = audit_defaults().settings.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub resolution: u32,
 
     /// Samples per pixel (the default keeps a sphere's standard error near 0.2 %).
-    #[arg(long, default_value_t = VerifyOptions::default().render.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, default_value_t = audit_defaults().settings.samples, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub spp: u32,
 
     /// Cycles' random seed (another seed gives the same means with fresh noise).
-    #[arg(long, default_value_t = VerifyOptions::default().render.seed)]
+    #[arg(long, default_value_t = audit_defaults().settings.seed)]
     pub seed: u32,
 
     /// Write a fixed copy of the one audited file here (flagged lobes replaced by their

@@ -207,6 +207,8 @@ mod tests {
     use super::*;
     use clap::CommandFactory;
     use gloffuse::blender::{BlenderOptions, InstallerOutput};
+    use gloffuse::generate::Mode;
+    use gloffuse::measure::Engine;
     use gloffuse::refresh::RefreshOptions;
     use gloffuse::verify::VerifyOptions;
 
@@ -215,38 +217,61 @@ mod tests {
         Cli::command().debug_assert();
     }
 
+    /// Without flags, the CLI passes no default of its own: each mode and engine reaches the
+    /// library unset, and the library resolves it (`VerifyOptions::resolve`,
+    /// `RefreshOptions::render`), so a library caller gets the same sweep.
     #[test]
     fn defaults_come_from_the_library() {
+        let blender = BlenderOptions {
+            installer_output: InstallerOutput::Stderr,
+            cancel: super::super::cancel().clone(),
+            ..BlenderOptions::default()
+        };
+        for mode in Mode::ALL {
+            for engine in [Engine::Cycles, Engine::Eevee] {
+                let cli = Cli::try_parse_from([
+                    "gloffuse",
+                    "verify",
+                    "--mode",
+                    mode.key(),
+                    "--engine",
+                    engine.key(),
+                ])
+                .unwrap();
+                let Command::Verify(v) = cli.command else {
+                    panic!("verify parses as verify")
+                };
+                let library = VerifyOptions {
+                    mode,
+                    engine,
+                    blender: blender.clone(),
+                    ..VerifyOptions::default()
+                };
+                assert_eq!(v.options(), library, "{} in {}", mode.key(), engine.key());
+            }
+        }
         let cli = Cli::try_parse_from(["gloffuse", "verify"]).unwrap();
         let Command::Verify(v) = cli.command else {
             panic!("verify parses as verify")
         };
-        assert_eq!(
-            v.options(),
-            VerifyOptions {
-                blender: BlenderOptions {
-                    installer_output: InstallerOutput::Stderr,
-                    cancel: super::super::cancel().clone(),
-                    ..BlenderOptions::default()
-                },
-                ..VerifyOptions::default()
-            }
-        );
-        let cli = Cli::try_parse_from(["gloffuse", "refresh"]).unwrap();
-        let Command::Refresh(r) = cli.command else {
-            panic!("refresh parses as refresh")
+        let library = VerifyOptions {
+            blender: blender.clone(),
+            ..VerifyOptions::default()
         };
-        assert_eq!(
-            r.options(),
-            RefreshOptions {
-                blender: BlenderOptions {
-                    installer_output: InstallerOutput::Stderr,
-                    cancel: super::super::cancel().clone(),
-                    ..BlenderOptions::default()
-                },
+        assert_eq!(v.options(), library);
+        for engine in [Engine::Cycles, Engine::Eevee] {
+            let cli =
+                Cli::try_parse_from(["gloffuse", "refresh", "--engine", engine.key()]).unwrap();
+            let Command::Refresh(r) = cli.command else {
+                panic!("refresh parses as refresh")
+            };
+            let library = RefreshOptions {
+                engine,
+                blender: blender.clone(),
                 ..RefreshOptions::default()
-            }
-        );
+            };
+            assert_eq!(r.options(), library, "{}", engine.key());
+        }
     }
 
     /// Every flag of every command has real help: at least four words.

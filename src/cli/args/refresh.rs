@@ -7,7 +7,6 @@ use super::blender::BlenderArgs;
 use super::parse::{ENGINES, one_of};
 use gloffuse::measure::Engine;
 use gloffuse::refresh::RefreshOptions;
-use gloffuse::verify::RenderSettings;
 
 fn refresh_defaults() -> RefreshOptions {
     RefreshOptions::default()
@@ -25,7 +24,7 @@ pub struct RefreshArgs {
 
     /// The engine to measure: cycles, or eevee (the file then corrects EEVEE's Glossy, each
     /// sphere divided by a white Diffuse one: EEVEE Next's lighting is 0.8 % dark).
-    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = Engine::Cycles.key())]
+    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = refresh_defaults().engine.key())]
     pub engine: Engine,
 
     /// Samples per pixel for the measurement [default: Cycles 64, EEVEE 1].
@@ -33,7 +32,7 @@ pub struct RefreshArgs {
     pub spp: Option<u32>,
 
     /// Pixels across each sphere's cell.
-    #[arg(long, default_value_t = refresh_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    #[arg(long, default_value_t = refresh_defaults().cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub resolution: u32,
 
     /// Skip the verify run with the new coefficients.
@@ -49,16 +48,14 @@ pub struct RefreshArgs {
 }
 
 impl RefreshArgs {
+    /// Only what the user gave: the library picks the engine's samples.
     pub fn options(&self) -> RefreshOptions {
-        let defaults = RefreshOptions::for_engine(self.engine);
         RefreshOptions {
             out: self.out.clone(),
             degree: self.degree as usize,
-            render: RenderSettings {
-                cell: self.resolution,
-                samples: self.spp.unwrap_or(defaults.render.samples),
-                ..defaults.render
-            },
+            engine: self.engine,
+            cell: self.resolution,
+            samples: self.spp,
             verify: !self.no_verify,
             blender: self.blender.options(self.json),
         }

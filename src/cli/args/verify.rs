@@ -10,10 +10,7 @@ use super::parse::{
 };
 use gloffuse::generate::{ColorModel, Mode};
 use gloffuse::measure::{Distribution, Engine, Roughness};
-use gloffuse::verify::plan::default_samples;
-use gloffuse::verify::{
-    ANISOTROPIC_SWEEP, IOR_SWEEP, Judging, RenderSettings, VerifyOptions, block_roughness,
-};
+use gloffuse::verify::VerifyOptions;
 
 fn verify_defaults() -> VerifyOptions {
     VerifyOptions::default()
@@ -30,7 +27,7 @@ pub struct VerifyArgs {
     /// The engine to render in: cycles, or eevee (Legacy in 3.x, Next in 4.2+; rendered
     /// headless with the settings of docs/EEVEE.md, a white Diffuse sphere showing how bright
     /// its lighting is, and each sphere shown next to what Cycles renders).
-    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = Engine::Cycles.key())]
+    #[arg(long, value_parser = one_of(ENGINES, Engine::key), default_value = verify_defaults().engine.key())]
     pub engine: Engine,
 
     /// Distributions to check, comma-separated [default: all in the coefficients].
@@ -64,7 +61,7 @@ pub struct VerifyArgs {
     pub spp: Option<u32>,
 
     /// Pixels across each sphere's cell.
-    #[arg(long, default_value_t = verify_defaults().render.cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    #[arg(long, default_value_t = verify_defaults().cell, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub resolution: u32,
 
     /// Allowed |mean − 100 %| of a corrected sphere, in percent [default: Cycles 1, EEVEE 2,
@@ -73,7 +70,7 @@ pub struct VerifyArgs {
     pub tolerance: Option<f64>,
 
     /// Cycles' random seed (another seed gives the same means with fresh noise).
-    #[arg(long, default_value_t = verify_defaults().render.seed)]
+    #[arg(long, default_value_t = verify_defaults().seed)]
     pub seed: u32,
 
     /// Which correction to check: roughness (gain 100/f(r), judged by each sphere's mean),
@@ -120,41 +117,24 @@ pub struct VerifyArgs {
 }
 
 impl VerifyArgs {
+    /// Only what the user gave: the library fills the rest with the mode's and engine's
+    /// defaults ([`VerifyOptions::resolve`]).
     pub fn options(&self) -> VerifyOptions {
         VerifyOptions {
             coefficients: self.coefficients.clone(),
             distributions: self.distribution.clone(),
-            roughness: match (self.roughness.is_empty(), self.mode) {
-                (false, _) => self.roughness.clone(),
-                (true, Mode::Layered | Mode::Anisotropic | Mode::Glass) => block_roughness(),
-                (true, _) => verify_defaults().roughness,
-            },
-            ior: match (self.ior.is_empty(), self.mode) {
-                (true, Mode::Layered | Mode::Glass) => IOR_SWEEP.to_vec(),
-                _ => self.ior.clone(),
-            },
-            anisotropy: match (self.anisotropy.is_empty(), self.mode) {
-                (true, Mode::Anisotropic) => ANISOTROPIC_SWEEP.to_vec(),
-                _ => self.anisotropy.clone(),
-            },
-            render: RenderSettings {
-                cell: self.resolution,
-                samples: self.spp.unwrap_or(default_samples(self.engine, self.mode)),
-                seed: self.seed,
-                ..RenderSettings::for_engine(self.engine)
-            },
+            roughness: self.roughness.clone(),
+            ior: self.ior.clone(),
+            anisotropy: self.anisotropy.clone(),
+            engine: self.engine,
+            cell: self.resolution,
+            samples: self.spp,
+            seed: self.seed,
             mode: self.mode,
             color: self.color,
             color_model: self.color_model,
-            judging: {
-                let defaults = Judging::for_sweep(self.engine, self.mode);
-                Judging {
-                    tolerance_percent: self.tolerance.unwrap_or(defaults.tolerance_percent),
-                    ring_tolerance_percent: self
-                        .ring_tolerance
-                        .unwrap_or(defaults.ring_tolerance_percent),
-                }
-            },
+            tolerance_percent: self.tolerance,
+            ring_tolerance_percent: self.ring_tolerance,
             blender: self.blender.options(self.json),
         }
     }
