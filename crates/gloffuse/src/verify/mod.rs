@@ -492,97 +492,19 @@ mod tests {
         let grid = roughness(&[0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]);
         let block = roughness(&[0.1, 0.25, 0.5, 0.75, 1.0]);
         let iors = vec![1.33, 1.5, 2.0];
+        let (none, anisotropies) = (vec![], vec![0.5, 0.9, -0.9]);
+        // One line a case: mode, engine, roughness, IORs, anisotropies, spp, tolerances.
+        #[rustfmt::skip]
         let cases = [
-            (
-                Mode::Roughness,
-                Engine::Cycles,
-                &grid,
-                vec![],
-                vec![],
-                32,
-                1.0,
-                1.5,
-            ),
-            (
-                Mode::View,
-                Engine::Cycles,
-                &grid,
-                vec![],
-                vec![],
-                32,
-                1.0,
-                1.5,
-            ),
-            (
-                Mode::Multiscatter,
-                Engine::Cycles,
-                &grid,
-                vec![],
-                vec![],
-                32,
-                1.0,
-                1.5,
-            ),
-            (
-                Mode::Roughness,
-                Engine::Eevee,
-                &grid,
-                vec![],
-                vec![],
-                1,
-                2.0,
-                2.0,
-            ),
-            (
-                Mode::View,
-                Engine::Eevee,
-                &grid,
-                vec![],
-                vec![],
-                1,
-                2.0,
-                2.0,
-            ),
-            (
-                Mode::Multiscatter,
-                Engine::Eevee,
-                &grid,
-                vec![],
-                vec![],
-                1,
-                2.0,
-                2.0,
-            ),
-            (
-                Mode::Layered,
-                Engine::Cycles,
-                &block,
-                iors.clone(),
-                vec![],
-                32,
-                1.0,
-                1.5,
-            ),
-            (
-                Mode::Anisotropic,
-                Engine::Cycles,
-                &block,
-                vec![],
-                vec![0.5, 0.9, -0.9],
-                32,
-                1.0,
-                1.5,
-            ),
-            (
-                Mode::Glass,
-                Engine::Cycles,
-                &block,
-                iors.clone(),
-                vec![],
-                256,
-                2.0,
-                3.0,
-            ),
+            (Mode::Roughness, Engine::Cycles, &grid, &none, &none, 32, 1.0, 1.5),
+            (Mode::View, Engine::Cycles, &grid, &none, &none, 32, 1.0, 1.5),
+            (Mode::Multiscatter, Engine::Cycles, &grid, &none, &none, 32, 1.0, 1.5),
+            (Mode::Roughness, Engine::Eevee, &grid, &none, &none, 1, 2.0, 2.0),
+            (Mode::View, Engine::Eevee, &grid, &none, &none, 1, 2.0, 2.0),
+            (Mode::Multiscatter, Engine::Eevee, &grid, &none, &none, 1, 2.0, 2.0),
+            (Mode::Layered, Engine::Cycles, &block, &iors, &none, 32, 1.0, 1.5),
+            (Mode::Anisotropic, Engine::Cycles, &block, &none, &anisotropies, 32, 1.0, 1.5),
+            (Mode::Glass, Engine::Cycles, &block, &iors, &none, 256, 2.0, 3.0),
         ];
         for (mode, engine, roughness, ior, anisotropy, samples, tolerance, ring) in cases {
             let v = VerifyOptions {
@@ -593,8 +515,8 @@ mod tests {
             let resolved = v.resolve();
             let case = format!("{} in {}", mode.key(), engine.key());
             assert_eq!(&resolved.roughness, roughness, "{case}");
-            assert_eq!(resolved.ior, ior, "{case}");
-            assert_eq!(resolved.anisotropy, anisotropy, "{case}");
+            assert_eq!(&resolved.ior, ior, "{case}");
+            assert_eq!(&resolved.anisotropy, anisotropy, "{case}");
             let render = resolved.render;
             assert_eq!(
                 (render.engine, render.cell, render.samples, render.seed),
