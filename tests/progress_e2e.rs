@@ -119,7 +119,7 @@ fn the_verify_render_follows_cycles_estimate_in_every_blender(
     };
     // Long enough that the watcher (every 200 ms) sees a line between the first
     // sample and the last.
-    options.render.samples = 512;
+    options.samples = Some(512);
     let recorded = Recorded::default();
     verify_with(&blender, &options, &recorded).unwrap();
 

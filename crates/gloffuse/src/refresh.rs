@@ -14,7 +14,7 @@ use crate::output::check_destination;
 use crate::progress::Progress;
 use crate::verify::stats::SphereStats;
 use crate::verify::{
-    Judging, Plan, RenderSettings, Rendered, Role, VerifyOptions, VerifyReport, render, verify_with,
+    Plan, RenderSettings, Rendered, Role, VerifyOptions, VerifyReport, render, verify_with,
 };
 
 /// What `refresh` measures and where it writes the result.
@@ -24,9 +24,13 @@ pub struct RefreshOptions {
     pub out: PathBuf,
     /// Polynomial degree in r.
     pub degree: usize,
-    /// How (and in which engine) the measurement is rendered (the verify run uses verify's
-    /// own samples).
-    pub render: RenderSettings,
+    /// The engine to measure (and verify in).
+    pub engine: Engine,
+    /// Pixels per sphere cell, of the measurement and the verify run.
+    pub cell: u32,
+    /// Samples per pixel of the measurement (`None`: the engine's, [`measure_samples`]; the
+    /// verify run uses verify's own).
+    pub samples: Option<u32>,
     /// Verify the new coefficients afterwards.
     pub verify: bool,
     pub blender: BlenderOptions,
@@ -34,21 +38,26 @@ pub struct RefreshOptions {
 
 impl Default for RefreshOptions {
     fn default() -> Self {
-        RefreshOptions::for_engine(Engine::Cycles)
+        let render = RenderSettings::default();
+        RefreshOptions {
+            out: PathBuf::from("coefficients.json"),
+            degree: INTEGRATOR_DEGREE,
+            engine: render.engine,
+            cell: render.cell,
+            samples: None,
+            verify: true,
+            blender: BlenderOptions::default(),
+        }
     }
 }
 
 impl RefreshOptions {
-    pub fn for_engine(engine: Engine) -> Self {
-        RefreshOptions {
-            out: PathBuf::from("coefficients.json"),
-            degree: INTEGRATOR_DEGREE,
-            render: RenderSettings {
-                samples: measure_samples(engine),
-                ..RenderSettings::for_engine(engine)
-            },
-            verify: true,
-            blender: BlenderOptions::default(),
+    /// How the measurement is rendered: the engine's samples unless some are set.
+    pub fn render(&self) -> RenderSettings {
+        RenderSettings {
+            cell: self.cell,
+            samples: self.samples.unwrap_or(measure_samples(self.engine)),
+            ..RenderSettings::for_engine(self.engine)
         }
     }
 }
@@ -100,9 +109,9 @@ fn grid() -> Vec<Roughness> {
 pub fn refresh(a: &RefreshOptions, progress: &dyn Progress) -> Result<Refreshed, Error> {
     // The output is checked before Blender is looked for: bad input fails fast.
     check_destination(&a.out)?;
-    let engine = a.render.engine;
+    let engine = a.engine;
     let blender = a.blender.find(progress)?;
-    let plan = Plan::measure(&Distribution::ALL, &grid(), a.render);
+    let plan = Plan::measure(&Distribution::ALL, &grid(), a.render());
     let stats = render_plain(&blender, &plan, a, progress)?;
     // EEVEE Next's world lighting is 0.8 % dark for every material: the curve corrects the
     // BSDF's loss, measured against a white Diffuse sphere in the same image.
@@ -205,7 +214,7 @@ fn fit_measured(
     lighting: Option<f64>,
     measurements: &[Measurement],
 ) -> Result<Coefficients, Error> {
-    let engine = a.render.engine;
+    let engine = a.engine;
     let points = Distribution::ALL.map(|d| {
         let points = measurements
             .iter()
@@ -221,7 +230,9 @@ fn fit_measured(
         format!("measured in {engine}, Blender {}", blender.version_string),
         format!(
             "Mean brightness of white glossy furnace spheres rendered in {engine}, Blender {} ({} spp, {} px), fitted by gloffuse refresh; gain = 100 / f(r).",
-            blender.version_string, a.render.samples, a.render.cell
+            blender.version_string,
+            a.render().samples,
+            a.cell
         ),
         &fit_spec(blender, a, lighting),
         points,
@@ -230,7 +241,7 @@ fn fit_measured(
 
 /// How the measurements are fitted, and where they come from.
 fn fit_spec(blender: &Blender, a: &RefreshOptions, lighting: Option<f64>) -> FitSpec {
-    let engine = a.render.engine;
+    let engine = a.engine;
     FitSpec {
         degree: a.degree,
         weighting: Weighting::Relative,
@@ -241,8 +252,8 @@ fn fit_spec(blender: &Blender, a: &RefreshOptions, lighting: Option<f64>) -> Fit
         provenance: Provenance {
             source: Source::Blender,
             blender_version: Some(blender.version_string.clone()),
-            samples: Some(format!("{} spp", a.render.samples)),
-            resolution: Some(a.render.cell),
+            samples: Some(format!("{} spp", a.render().samples)),
+            resolution: Some(a.cell),
             points: 0,
             date: Some(today()),
             note: Some(match engine {
@@ -263,17 +274,34 @@ fn verify_new(
     a: &RefreshOptions,
     progress: &dyn Progress,
 ) -> Result<VerifyReport, Error> {
-    let engine = a.render.engine;
     let v = VerifyOptions {
         coefficients: Some(a.out.display().to_string()),
-        render: RenderSettings {
-            cell: a.render.cell,
-            seed: 1,
-            ..RenderSettings::for_engine(engine)
-        },
-        judging: Judging::for_engine(engine),
+        engine: a.engine,
+        cell: a.cell,
+        seed: 1,
         blender: a.blender.clone(),
         ..VerifyOptions::default()
     };
     Ok(verify_with(blender, &v, progress)?.report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each engine with nothing set measures at its own samples: Cycles 64, EEVEE 1.
+    #[test]
+    fn each_engine_with_nothing_set_measures_at_its_samples() {
+        for (engine, samples) in [(Engine::Cycles, 64), (Engine::Eevee, 1)] {
+            let a = RefreshOptions {
+                engine,
+                ..RefreshOptions::default()
+            };
+            let render = a.render();
+            assert_eq!(
+                (render.engine, render.cell, render.samples, render.seed),
+                (engine, 64, samples, 0)
+            );
+        }
+    }
 }

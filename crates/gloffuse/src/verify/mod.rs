@@ -26,29 +26,100 @@ use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
 use crate::measure::{Anisotropy, BlenderVersion, Distribution, Engine, Roughness, coat};
 use crate::progress::Progress;
 
-/// What `verify` renders and how it judges it.
+/// What `verify` renders and how it judges it. An input left empty or `None` takes the
+/// default of the mode and engine ([`VerifyOptions::resolve`]), so a caller who sets only
+/// the mode gets the sweep the command line renders for it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VerifyOptions {
     /// A preset or coefficients file (else the preset of the Blender used).
     pub coefficients: Option<String>,
     /// The distributions to check (empty: all the coefficients hold).
     pub distributions: Vec<Distribution>,
-    /// The roughness values of the sweep, each once.
+    /// The roughness values of the sweep, each once (empty: the mode's, [`mode_roughness`]).
     pub roughness: Vec<Roughness>,
-    /// Layered mode: the coats' indices of refraction, each once, from 1 to
-    /// [`coat::IOR_MAX`] (every other mode: none).
+    /// Layered and glass mode: the indices of refraction, each once, from 1 to
+    /// [`coat::IOR_MAX`] (empty: [`IOR_SWEEP`]; every other mode: none).
     pub ior: Vec<f64>,
-    /// Anisotropic mode: the lobes' anisotropies, each once, from −0.99 to 0.99 (every
-    /// other mode: none).
+    /// Anisotropic mode: the lobes' anisotropies, each once, from −0.99 to 0.99 (empty:
+    /// [`ANISOTROPIC_SWEEP`]; every other mode: none).
     pub anisotropy: Vec<f64>,
-    pub render: RenderSettings,
+    /// The engine that renders the sweep.
+    pub engine: Engine,
+    /// Pixels per sphere cell.
+    pub cell: u32,
+    /// Samples per pixel (`None`: the mode's and engine's, [`plan::default_samples`]).
+    pub samples: Option<u32>,
+    /// Cycles' random seed.
+    pub seed: u32,
     pub mode: Mode,
     /// The spheres' colour (linear RGB, each in [0, 1]).
     pub color: [f64; 3],
     /// What the corrections promise for a colour.
     pub color_model: ColorModel,
-    pub judging: Judging,
+    /// Allowed |mean − 100 %| of a corrected sphere, in percent (`None`: the sweep's,
+    /// [`Judging::for_sweep`]).
+    pub tolerance_percent: Option<f64>,
+    /// Allowed |ring mean − 100 %| in the view modes, in percent (`None`: the sweep's).
+    pub ring_tolerance_percent: Option<f64>,
     pub blender: BlenderOptions,
+}
+
+/// A verify sweep with every default filled in: what one run renders and judges by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resolved {
+    pub roughness: Vec<Roughness>,
+    pub ior: Vec<f64>,
+    pub anisotropy: Vec<f64>,
+    pub render: RenderSettings,
+    pub judging: Judging,
+}
+
+impl VerifyOptions {
+    /// The options with each input left unset taken from the mode and engine: the one place
+    /// verify's defaults are chosen, for the command line and every other caller.
+    pub fn resolve(&self) -> Resolved {
+        let (mode, engine) = (self.mode, self.engine);
+        let given_or = |given: &[f64], default: &[f64]| match given.is_empty() {
+            true => default.to_vec(),
+            false => given.to_vec(),
+        };
+        let judging = Judging::for_sweep(engine, mode);
+        Resolved {
+            roughness: match self.roughness.is_empty() {
+                true => mode_roughness(mode),
+                false => self.roughness.clone(),
+            },
+            ior: match mode {
+                Mode::Layered | Mode::Glass => given_or(&self.ior, &IOR_SWEEP),
+                _ => self.ior.clone(),
+            },
+            anisotropy: match mode {
+                Mode::Anisotropic => given_or(&self.anisotropy, &ANISOTROPIC_SWEEP),
+                _ => self.anisotropy.clone(),
+            },
+            render: RenderSettings {
+                cell: self.cell,
+                samples: self.samples.unwrap_or(plan::default_samples(engine, mode)),
+                seed: self.seed,
+                ..RenderSettings::for_engine(engine)
+            },
+            judging: Judging {
+                tolerance_percent: self.tolerance_percent.unwrap_or(judging.tolerance_percent),
+                ring_tolerance_percent: self
+                    .ring_tolerance_percent
+                    .unwrap_or(judging.ring_tolerance_percent),
+            },
+        }
+    }
+}
+
+/// The roughness values a sweep of `mode` checks unless told: the layered, anisotropic and
+/// glass tables' sweep is shorter, each of its rows being repeated per index or anisotropy.
+pub fn mode_roughness(mode: Mode) -> Vec<Roughness> {
+    match mode {
+        Mode::Layered | Mode::Anisotropic | Mode::Glass => block_roughness(),
+        Mode::Roughness | Mode::View | Mode::Multiscatter => default_roughness(),
+    }
 }
 
 /// The verify sweep's roughness values: 0, 0.1, …, 1.
@@ -75,17 +146,22 @@ pub const ANISOTROPIC_SWEEP: [f64; 3] = [0.5, 0.9, -0.9];
 
 impl Default for VerifyOptions {
     fn default() -> Self {
+        let render = RenderSettings::default();
         VerifyOptions {
             coefficients: None,
             distributions: Vec::new(),
-            roughness: default_roughness(),
+            roughness: Vec::new(),
             ior: Vec::new(),
             anisotropy: Vec::new(),
-            render: RenderSettings::default(),
+            engine: render.engine,
+            cell: render.cell,
+            samples: None,
+            seed: render.seed,
             mode: Mode::Roughness,
             color: [1.0; 3],
             color_model: ColorModel::Exact,
-            judging: Judging::default(),
+            tolerance_percent: None,
+            ring_tolerance_percent: None,
             blender: BlenderOptions::default(),
         }
     }
@@ -100,7 +176,7 @@ pub struct Verification {
 /// Checks the options, finds Blender, then [`verify_with`]. Bad input fails before Blender
 /// is looked for.
 pub fn verify(v: &VerifyOptions, progress: &dyn Progress) -> Result<Verification, Error> {
-    check_options(v)?;
+    check_options(v, &v.resolve())?;
     check_color(v.color)?;
     if let Some(name) = &v.coefficients {
         distributions_of(v, &Coefficients::load(name)?, name)?;
@@ -115,13 +191,19 @@ pub fn verify_with(
     v: &VerifyOptions,
     progress: &dyn Progress,
 ) -> Result<Verification, Error> {
-    check_options(v)?;
+    let resolved = v.resolve();
+    check_options(v, &resolved)?;
     let (coefficients, source) =
-        Coefficients::load_or_preset(v.coefficients.as_deref(), v.render.engine, blender.version)?;
+        Coefficients::load_or_preset(v.coefficients.as_deref(), v.engine, blender.version)?;
     let distributions = distributions_of(v, &coefficients, &source)?;
     let distributions = with_groups(v, distributions, blender.version)?;
-    let blocks = blocks(v);
-    let plan = Plan::verify(&distributions, &v.roughness, &blocks, v.render);
+    let blocks = blocks(&resolved);
+    let plan = Plan::verify(
+        &distributions,
+        &resolved.roughness,
+        &blocks,
+        resolved.render,
+    );
     let curves = Curves::Pinned {
         coefficients: &coefficients,
         name: &source,
@@ -139,22 +221,22 @@ pub fn verify_with(
         coefficients: &coefficients,
         source: &source,
         distributions: &distributions,
-        roughness: &v.roughness,
+        roughness: &resolved.roughness,
         blocks: &blocks,
         mode: v.mode,
         color: v.color,
         color_model: v.color_model,
     };
-    let report = judge(&rendered, &sweep, v.judging, blender.version);
+    let report = judge(&rendered, &sweep, resolved.judging, blender.version);
     Ok(Verification { report, rendered })
 }
 
-/// What can be checked before Blender is found.
-fn check_options(v: &VerifyOptions) -> Result<(), Error> {
-    check_roughness(&v.roughness)?;
-    check_ior(v.mode, &v.ior)?;
-    check_anisotropy(v.mode, &v.anisotropy)?;
-    check_engine(v.render.engine, v.mode)?;
+/// What can be checked before Blender is found (`resolved`: the options' defaults filled).
+fn check_options(v: &VerifyOptions, resolved: &Resolved) -> Result<(), Error> {
+    check_roughness(&resolved.roughness)?;
+    check_ior(v.mode, &resolved.ior)?;
+    check_anisotropy(v.mode, &resolved.anisotropy)?;
+    check_engine(v.engine, v.mode)?;
     check_color_model(v.mode, v.color_model)?;
     check_glass_color(v.mode, v.color)
 }
@@ -178,9 +260,9 @@ fn check_glass_color(mode: Mode, color: [f64; 3]) -> Result<(), Error> {
 }
 
 /// Each block of rows: the indices (layered mode) or the anisotropies (anisotropic mode).
-fn blocks(v: &VerifyOptions) -> Vec<Block> {
-    let ior = v.ior.iter().map(|&n| Block::Ior(n));
-    ior.chain(v.anisotropy.iter().map(|&a| Block::Anisotropy(a)))
+fn blocks(resolved: &Resolved) -> Vec<Block> {
+    let ior = resolved.ior.iter().map(|&n| Block::Ior(n));
+    ior.chain(resolved.anisotropy.iter().map(|&a| Block::Anisotropy(a)))
         .collect()
 }
 
@@ -234,7 +316,7 @@ fn check_color_model(mode: Mode, model: ColorModel) -> Result<(), Error> {
     Ok(())
 }
 
-/// Anisotropic mode needs anisotropies, each once and in [−0.99, 0.99] (what Cycles
+/// Anisotropic mode's anisotropies are each given once and in [−0.99, 0.99] (what Cycles
 /// clamps to); every other mode takes none.
 fn check_anisotropy(mode: Mode, anisotropy: &[f64]) -> Result<(), Error> {
     if mode != Mode::Anisotropic {
@@ -249,13 +331,6 @@ fn check_anisotropy(mode: Mode, anisotropy: &[f64]) -> Result<(), Error> {
             )),
             None => Ok(()),
         };
-    }
-    if anisotropy.is_empty() {
-        return Err(Error::input(
-            Field::Anisotropy,
-            "",
-            Hint::new("at least one anisotropy for {} anisotropic", [Field::Mode]),
-        ));
     }
     for (i, &a) in anisotropy.iter().enumerate() {
         let clamped = Anisotropy::new(a).ok().map(Anisotropy::get);
@@ -283,8 +358,8 @@ pub fn check_color(color: [f64; 3]) -> Result<(), Error> {
     ))
 }
 
-/// Layered and glass mode need indices of refraction, each once and within the tables
-/// (the coat's and the glass's share their axis); every other mode takes none.
+/// Layered and glass mode's indices of refraction are each given once and within the
+/// tables (the coat's and the glass's share their axis); every other mode takes none.
 fn check_ior(mode: Mode, ior: &[f64]) -> Result<(), Error> {
     if !matches!(mode, Mode::Layered | Mode::Glass) {
         return match ior.first() {
@@ -298,16 +373,6 @@ fn check_ior(mode: Mode, ior: &[f64]) -> Result<(), Error> {
             )),
             None => Ok(()),
         };
-    }
-    if ior.is_empty() {
-        return Err(Error::input(
-            Field::Ior,
-            "",
-            Hint::new(
-                format!("at least one index of refraction for {{}} {}", mode.key()),
-                [Field::Mode],
-            ),
-        ));
     }
     for (i, n) in ior.iter().enumerate() {
         let range = 1.0..=coat::IOR_MAX;
@@ -414,6 +479,89 @@ mod tests {
 
     fn version(v: &str) -> BlenderVersion {
         v.parse().unwrap()
+    }
+
+    fn roughness(values: &[f64]) -> Vec<Roughness> {
+        values.iter().map(|&r| Roughness::new(r).unwrap()).collect()
+    }
+
+    /// Each mode and engine with nothing set resolves to the sweep the command line runs
+    /// with no flags (the numbers written out here, not read from the constants).
+    #[test]
+    fn each_mode_with_nothing_set_resolves_to_its_defaults() {
+        let grid = roughness(&[0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]);
+        let block = roughness(&[0.1, 0.25, 0.5, 0.75, 1.0]);
+        let iors = vec![1.33, 1.5, 2.0];
+        let (none, anisotropies) = (vec![], vec![0.5, 0.9, -0.9]);
+        // One line a case: mode, engine, roughness, IORs, anisotropies, spp, tolerances.
+        #[rustfmt::skip]
+        let cases = [
+            (Mode::Roughness, Engine::Cycles, &grid, &none, &none, 32, 1.0, 1.5),
+            (Mode::View, Engine::Cycles, &grid, &none, &none, 32, 1.0, 1.5),
+            (Mode::Multiscatter, Engine::Cycles, &grid, &none, &none, 32, 1.0, 1.5),
+            (Mode::Roughness, Engine::Eevee, &grid, &none, &none, 1, 2.0, 2.0),
+            (Mode::View, Engine::Eevee, &grid, &none, &none, 1, 2.0, 2.0),
+            (Mode::Multiscatter, Engine::Eevee, &grid, &none, &none, 1, 2.0, 2.0),
+            (Mode::Layered, Engine::Cycles, &block, &iors, &none, 32, 1.0, 1.5),
+            (Mode::Anisotropic, Engine::Cycles, &block, &none, &anisotropies, 32, 1.0, 1.5),
+            (Mode::Glass, Engine::Cycles, &block, &iors, &none, 256, 2.0, 3.0),
+        ];
+        for (mode, engine, roughness, ior, anisotropy, samples, tolerance, ring) in cases {
+            let v = VerifyOptions {
+                mode,
+                engine,
+                ..VerifyOptions::default()
+            };
+            let resolved = v.resolve();
+            let case = format!("{} in {}", mode.key(), engine.key());
+            assert_eq!(&resolved.roughness, roughness, "{case}");
+            assert_eq!(&resolved.ior, ior, "{case}");
+            assert_eq!(&resolved.anisotropy, anisotropy, "{case}");
+            let render = resolved.render;
+            assert_eq!(
+                (render.engine, render.cell, render.samples, render.seed),
+                (engine, 64, samples, 0),
+                "{case}"
+            );
+            assert_eq!(
+                (
+                    resolved.judging.tolerance_percent,
+                    resolved.judging.ring_tolerance_percent
+                ),
+                (tolerance, ring),
+                "{case}"
+            );
+            check_options(&v, &resolved).unwrap_or_else(|e| panic!("{case}: {e}"));
+        }
+    }
+
+    /// What a caller sets is kept, whatever the mode's default.
+    #[test]
+    fn what_is_set_overrides_the_defaults() {
+        let v = VerifyOptions {
+            mode: Mode::Glass,
+            roughness: roughness(&[0.5]),
+            ior: vec![1.2],
+            samples: Some(64),
+            tolerance_percent: Some(4.0),
+            ..VerifyOptions::default()
+        };
+        let resolved = v.resolve();
+        assert_eq!(resolved.roughness, roughness(&[0.5]));
+        assert_eq!(resolved.ior, [1.2]);
+        assert_eq!(resolved.render.samples, 64);
+        assert_eq!(resolved.judging.tolerance_percent, 4.0);
+        assert_eq!(resolved.judging.ring_tolerance_percent, 3.0);
+        // An index in a mode that takes none is kept, so the check refuses it.
+        let roughness_mode = VerifyOptions {
+            ior: vec![1.5],
+            ..VerifyOptions::default()
+        };
+        let refused = check_options(&roughness_mode, &roughness_mode.resolve()).unwrap_err();
+        assert!(
+            refused.to_string().contains("index of refraction"),
+            "{refused}"
+        );
     }
 
     /// Glass mode sweeps GGX and Beckmann in every Blender that gets glass groups, and
