@@ -368,9 +368,9 @@ fn parse_import(
 }
 
 /// The modules `entry` needs and `entry` itself, dependencies first, from the package
-/// `modules` plus `extra` (a module outside the package, such as a test's main, as
-/// `(name, text)`); `entry` is a name in either.
-fn bundle_from(
+/// `modules` (`(name, text)`, as `MODULES`) plus `extra` (a module outside the package,
+/// such as a test's main, as `(name, text)`); `entry` is a name in either.
+pub fn bundle_from(
     modules: &[(&str, &str)],
     extra: Option<(&str, &str)>,
     entry: &str,
