@@ -55,6 +55,10 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/compat.py"),
     ),
     (
+        "contract",
+        include_str!("../../../../blender/gloffuse_blender/contract.py"),
+    ),
+    (
         "furnace",
         include_str!("../../../../blender/gloffuse_blender/furnace.py"),
     ),
