@@ -20,11 +20,10 @@ fn contract() -> Value {
         .find(|(name, _)| *name == "contract")
         .expect("contract.py is bundled")
         .1;
-    let start = text
-        .find("CONTRACT = ")
-        .expect("contract.py defines CONTRACT")
-        + 11;
-    serde_json::Deserializer::from_str(&text[start..])
+    let (_, literal) = text
+        .split_once("CONTRACT = ")
+        .expect("contract.py defines CONTRACT");
+    serde_json::Deserializer::from_str(literal)
         .into_iter::<Value>()
         .next()
         .expect("CONTRACT has a value")
@@ -241,10 +240,7 @@ mod tests {
         assert!(kinds.len() > 20, "{:?}", kinds.keys());
         let wrong = Value::Object(Map::from_iter([("nothing".into(), Value::Null)]));
         let err = Checker::new().check(&wrong, "catalog", "c").unwrap_err();
-        assert!(
-            err.contains("is missing") || err.contains("not a field"),
-            "{err}"
-        );
+        assert_eq!(err, "c: the catalog field path is missing");
     }
 
     /// Every document the library sends, checked; together they send every field the
