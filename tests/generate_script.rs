@@ -4,6 +4,7 @@
 //! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
 use gloffuse::fit::Coefficients;
+use gloffuse::generate::bundle::{bundle, bundle_from, concatenate};
 use gloffuse::generate::{ColorModel, Curves, GenerateParams, Job, Mode, assemble};
 use gloffuse::measure::Masking;
 use proptest::prelude::*;
@@ -49,25 +50,80 @@ fn check_scripts(dir: &Path, cases: &[(String, serde_json::Value)]) {
     );
 }
 
-#[test]
-fn golden_seed_script_is_byte_stable() {
-    let a = assemble(&seed_params(), Job::Generate);
-    let b = assemble(&seed_params(), Job::Generate);
-    assert_eq!(a, b);
-    let golden_path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/generate-seed.py");
+/// `text` equals the golden file `name` in `tests/golden/`; `GLOFFUSE_BLESS=1` writes it.
+fn assert_golden(name: &str, text: &str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(name);
     if std::env::var_os("GLOFFUSE_BLESS").is_some() {
-        std::fs::write(golden_path, &a).unwrap();
+        std::fs::write(&path, text).unwrap();
     }
-    let golden = std::fs::read_to_string(golden_path)
-        .expect("golden file (regenerate with GLOFFUSE_BLESS=1)");
+    let golden = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{} ({e}; write it with GLOFFUSE_BLESS=1)", path.display()));
     assert_eq!(
-        a, golden,
-        "generated script changed; if intended, rerun with GLOFFUSE_BLESS=1 and review the diff"
+        text, golden,
+        "{name} changed; if intended, rerun with GLOFFUSE_BLESS=1 and review the diff"
     );
-    // The golden file is only trusted because it is also checked independently:
+}
+
+/// The modules of the fixture package `tests/fixtures/bundle/`, by name.
+fn fixture_package() -> Vec<(String, String)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/bundle");
+    let mut modules: Vec<(String, String)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|entry| {
+            let path = entry.unwrap().path();
+            let name = path.file_stem().unwrap().to_str().unwrap().to_string();
+            (name, std::fs::read_to_string(&path).unwrap())
+        })
+        .collect();
+    modules.sort();
+    modules
+}
+
+/// The bundler on a package of four tiny modules: the order their imports give, the
+/// package imports dropped, a standard import made once, the unimported module left out.
+#[test]
+fn the_bundler_makes_the_golden_bundle_of_the_fixture_package() {
+    let modules = fixture_package();
+    let modules: Vec<(&str, &str)> = modules
+        .iter()
+        .map(|(n, t)| (n.as_str(), t.as_str()))
+        .collect();
+    let bundled = concatenate(&bundle_from(&modules, None, "job").unwrap());
+    assert_eq!(
+        bundled,
+        concatenate(&bundle_from(&modules, None, "job").unwrap())
+    );
+    assert_golden("bundle-fixture.py", &bundled);
+}
+
+/// The seed library's parameter document, as the generate job gets it (pretty-printed
+/// here; the script holds it on one line).
+#[test]
+fn the_seed_document_is_the_golden_one() {
+    let document = serde_json::to_string_pretty(&seed_params()).unwrap();
+    assert_golden("generate-seed.json", &format!("{document}\n"));
+}
+
+/// A generate script is the header with the document, the bundle of the generate job's
+/// modules, and the call of its main; made twice, it is the same bytes.
+#[test]
+fn the_seed_script_is_byte_stable_and_holds_the_bundle() {
+    let script = assemble(&seed_params(), Job::Generate);
+    assert_eq!(script, assemble(&seed_params(), Job::Generate));
+    let document = serde_json::to_string(&seed_params()).unwrap();
+    let literal = serde_json::to_string(&document).unwrap();
+    let header = script.split_once(&format!("GLOFFUSE_PARAMS = {literal}\n"));
+    let (_, rest) = header.expect("the document's literal on its own line");
+    let bundled = concatenate(&bundle(Job::Generate.module()).unwrap());
+    let main = rest
+        .strip_prefix(&bundled)
+        .expect("the bundle after the header");
+    assert!(main.ends_with("    main(GLOFFUSE_PARAMS)\n"), "{main}");
     let dir = tempfile::tempdir().unwrap();
     let expect = serde_json::to_value(seed_params()).unwrap();
-    check_scripts(dir.path(), &[(golden, expect)]);
+    check_scripts(dir.path(), &[(script, expect)]);
 }
 
 #[test]

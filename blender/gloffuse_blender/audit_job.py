@@ -35,6 +35,7 @@ from .audit_twin import (
     set_aside_groups,
 )
 from .compat import blender_version_string, filter_glossy_property, material_node_tree
+from .contract import check_fields
 from .furnace import (
     FURNACE_UV_MAP,
     furnace_layout,
@@ -76,6 +77,7 @@ def audit_require(cond, message):
 def audit_params(document):
     """The "audit" section, checked; numbers as the furnace wants them."""
     audit_require(isinstance(document, dict), "the parameter document must be an object")
+    check_fields(document, "audit_document", "the audit job's document")
     section = document.get("audit")
     audit_require(isinstance(section, dict), "the document has no \"audit\" object")
     render = bool(section.get("render", True))
@@ -356,7 +358,7 @@ def audit_main(document_text):
     if missing:
         # The groups' tables take gloffuse seconds to compute: it sends them only
         # to a job that asks, and runs it again.
-        print(result_line({"blender_version": blender_version_string(), "file": shown_path(path),
+        print(result_line("audit_result", {"blender_version": blender_version_string(), "file": shown_path(path),
                            "materials": [], "needs": missing, "scan_seconds": scan_seconds}))
         sys.stdout.flush()
         return
@@ -394,7 +396,7 @@ def audit_main(document_text):
                       for entry in entries],
         "fixed": fixed,
     }
-    print(result_line(result))
+    print(result_line("audit_result", result))
     sys.stdout.flush()
 
 

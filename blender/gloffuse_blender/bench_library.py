@@ -15,6 +15,7 @@ import json
 import bpy
 
 from .compat import compat_node_tree, glossy_node
+from .contract import check_fields
 from .runtime import result_line, run_main, save_blend
 
 # The kinds of material, in turn.
@@ -62,7 +63,7 @@ def bench_shader(kind, nodes, links, roughness):
 
 
 def bench_library_main(document_text):
-    section = json.loads(document_text)["bench_library"]
+    section = check_fields(json.loads(document_text), "bench_library_document")["bench_library"]
     bpy.ops.wm.read_factory_settings(use_empty=True)
     for index in range(section["first"], section["first"] + section["count"]):
         kind = BENCH_KINDS[index % len(BENCH_KINDS)]
@@ -75,7 +76,7 @@ def bench_library_main(document_text):
         shader = bench_shader(kind, tree.nodes, tree.links, roughness)
         tree.links.new(shader, output.inputs["Surface"])
     path = save_blend(section["output"])
-    print(result_line({"output": path, "materials": section["count"]}))
+    print(result_line("bench_library_result", {"output": path, "materials": section["count"]}))
 
 
 def main(document_text):

@@ -39,6 +39,7 @@ from .compat import (
     compat_principled_dielectric,
     glossy_node,
 )
+from .contract import check_fields
 from .meshes import sphere_mesh
 from .runtime import render_result_image
 
@@ -173,6 +174,7 @@ def furnace_color(section):
 def furnace_params(document):
     """The validated "furnace" section of the parameter document."""
     furnace_require(isinstance(document, dict), "the parameter document must be an object")
+    check_fields(document, "furnace_document", "the furnace job's document")
     section = document.get("furnace")
     furnace_require(isinstance(section, dict), "the document has no \"furnace\" object")
     output = section.get("output")

@@ -52,7 +52,7 @@ def furnace_main(document_text):
         "height": scene.render.resolution_y,
         "render_seconds": round(seconds, 3),
     }
-    print(result_line(result))
+    print(result_line("furnace_result", result))
     sys.stdout.flush()
 
 

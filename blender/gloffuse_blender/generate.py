@@ -70,7 +70,7 @@ def generate_main(document_text):
         open_blend(options.replace_library)
         refused = library_contents()
         if refused is not None:
-            print(result_line({"blender_version": blender_version_string(),
+            print(result_line("generate_result", {"blender_version": blender_version_string(),
                                "refused": refused, "saved": None}))
             sys.stdout.flush()
             return
@@ -100,7 +100,7 @@ def generate_main(document_text):
     names = []
     for _spec, trees in built:
         names.extend(tree.name for tree in trees)
-    print(result_line({
+    print(result_line("generate_result", {
         "blender_version": blender_version_string(),
         "groups": names,
         "renamed": renamed,

@@ -3,9 +3,11 @@
 # anything is built, and says what is wrong with it.
 #
 # A module of the gloffuse_blender package. Functions and constants only; uses
-# max_name_bytes() and masking_family() from compat.py.
+# max_name_bytes() and masking_family() from compat.py, check_fields() from
+# contract.py.
 #
-#   load_params(text) -> dict          parse the parameter JSON and resolve it
+#   load_params(text) -> dict          parse the parameter JSON, check its fields
+#                                      against the contract, and resolve it
 #   resolve_params(document) -> params the document as the builders read it:
 #                                      each group with the fields of the masking
 #                                      family of the Blender this runs in
@@ -15,6 +17,7 @@ import json
 import math
 
 from .compat import blender_at_least, masking_family, max_name_bytes
+from .contract import check_fields
 
 DISTRIBUTIONS = ("BECKMANN", "GGX", "ASHIKHMIN_SHIRLEY")
 CURVE_VARIABLES = ("roughness", "alpha")
@@ -241,5 +244,6 @@ def validate_params(params):
 
 
 def load_params(text):
-    """Parse the JSON parameter document and resolve it for this Blender."""
-    return resolve_params(json.loads(text))
+    """Parse the generate job's JSON parameter document, check its fields, and
+    resolve it for this Blender."""
+    return resolve_params(check_fields(json.loads(text), "generate_document"))

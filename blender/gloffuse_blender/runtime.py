@@ -4,13 +4,14 @@
 # files, the result line, and error handling that never quits an interactive
 # Blender.
 #
-# A module of the gloffuse_blender package; it imports none of the others.
+# A module of the gloffuse_blender package; of the others it imports only
+# contract.py (the result line's fields).
 # Functions and classes only.
 #
 #   script_args(argv=None) -> the arguments meant for the script
 #   ScriptArgumentParser, parse_script_args(parser) -> options (never exits)
 #   open_blend(path), save_blend(path, compress) -> absolute path
-#   result_line(payload) -> "GLOFFUSE_RESULT {...}"
+#   result_line(kind, payload) -> "GLOFFUSE_RESULT {...}", its fields checked
 #   shown_path(path) -> the path as UTF-8 text (bad bytes shown as U+FFFD)
 #   run_main(main) -> runs main with the error handling described there, and
 #       ends the process when main is done (see end_process)
@@ -24,6 +25,8 @@ import tempfile
 import traceback
 
 import bpy
+
+from .contract import check_fields
 
 def running_in_blender_binary():
     """True inside the blender executable (its Text Editor or --python),
@@ -142,8 +145,10 @@ def save_failure(path, compress, said):
             % (path, said, directory, _size(free)))
 
 
-def result_line(payload):
-    """The one machine-readable line a main prints on stdout."""
+def result_line(kind, payload):
+    """The one machine-readable line a main prints on stdout; `payload` must hold
+    the fields contract.py gives `kind`."""
+    check_fields(payload, kind, "the %s" % kind.replace("_", " "))
     return "GLOFFUSE_RESULT " + json.dumps(payload, sort_keys=True)
 
 

@@ -54,7 +54,7 @@ from gloffuse_blender.furnace import furnace_render_settings, furnace_world, ren
 from gloffuse_blender.groups import build_all
 from gloffuse_blender.meshes import sphere_mesh
 from gloffuse_blender.params import resolve_params
-from gloffuse_blender.runtime import result_line, run_main
+from gloffuse_blender.runtime import run_main
 
 
 def scene_section(document):
@@ -302,10 +302,11 @@ def scene_main(document_text):
         path = os.path.join(scene["output_dir"], variant["name"] + ".exr")
         render_sweep(path)
         written.append(path)
-    print(result_line({
+    # This test's own result, not one of the package's jobs (contract.py holds those).
+    print("GLOFFUSE_RESULT " + json.dumps({
         "blender_version": blender_version_string(),
         "written": written,
-    }))
+    }, sort_keys=True))
     sys.stdout.flush()
 
 

@@ -17,6 +17,8 @@ pub mod audit;
 pub mod bench;
 pub mod blend_file;
 pub mod blender;
+#[cfg(test)]
+mod contract;
 pub mod file_lock;
 pub mod fit;
 pub mod generate;

@@ -71,7 +71,7 @@ impl TwinNames {
 /// The job's parameter document: the generate fields (the groups twins may need), flattened,
 /// plus `audit`.
 #[derive(Serialize)]
-struct AuditParams<'a> {
+pub struct AuditParams<'a> {
     #[serde(flatten)]
     generate: Option<&'a GenerateParams>,
     audit: AuditSection,
@@ -193,24 +193,8 @@ pub fn run_job(s: &JobSettings, file: &Path, fix: Option<FixOutput>) -> Result<J
     let run_dir = runs::new_run_dir("audit")?;
     let exr = run_dir.join("audit.exr");
     let twin_exr = run_dir.join("audit-twins.exr");
-    let render = s.render.unwrap_or_default();
-    let section = AuditSection {
-        output: exr.to_string_lossy().into_owned(),
-        twin_output: twin_exr.to_string_lossy().into_owned(),
-        render: s.render.is_some(),
-        cell: render.cell,
-        samples: render.samples,
-        seed: render.seed,
-        threads: 0,
-        radius_fraction: render.radius_fraction,
-        rules: ranges(),
-        twin_names: TwinNames::new(),
-        fix: fix.map(|f| f.materials.to_vec()).unwrap_or_default(),
-    };
-    let params = AuditParams {
-        generate: s.groups,
-        audit: section,
-    };
+    let materials = fix.as_ref().map_or(&[][..], |f| f.materials);
+    let params = document(s.groups, s.render, &exr, &twin_exr, materials);
     let script = run_dir.join("gloffuse-audit.py");
     write_output(&script, assemble(&params, Job::Audit).as_bytes())?;
     let log = run_dir.join("blender.log");
@@ -239,6 +223,35 @@ pub fn run_job(s: &JobSettings, file: &Path, fix: Option<FixOutput>) -> Result<J
         exr,
         twin_exr,
     })
+}
+
+/// The job's parameter document: the groups twins may use (when they were asked for), the
+/// render settings (none: scan only), where the two renders go, and the materials to fix.
+pub fn document<'a>(
+    groups: Option<&'a GenerateParams>,
+    render: Option<RenderSettings>,
+    exr: &Path,
+    twin_exr: &Path,
+    fix: &[FixItem],
+) -> AuditParams<'a> {
+    let settings = render.unwrap_or_default();
+    let section = AuditSection {
+        output: exr.to_string_lossy().into_owned(),
+        twin_output: twin_exr.to_string_lossy().into_owned(),
+        render: render.is_some(),
+        cell: settings.cell,
+        samples: settings.samples,
+        seed: settings.seed,
+        threads: 0,
+        radius_fraction: settings.radius_fraction,
+        rules: ranges(),
+        twin_names: TwinNames::new(),
+        fix: fix.to_vec(),
+    };
+    AuditParams {
+        generate: groups,
+        audit: section,
+    }
 }
 
 /// The job's arguments: the file, and where its fixed copy goes.

@@ -128,6 +128,13 @@ pub(crate) fn options(b: &AuditBenchOptions, files: &[PathBuf], render: bool) ->
     }
 }
 
+/// The `bench_library` job's parameter document.
+pub fn library_document(path: &Path, first: usize, count: usize) -> serde_json::Value {
+    serde_json::json!({
+        "bench_library": {"output": path, "count": count, "first": first}
+    })
+}
+
 /// Saves a library of `count` materials numbered from `first` at `path`.
 pub(crate) fn library(
     blender: &Blender,
@@ -136,9 +143,7 @@ pub(crate) fn library(
     first: usize,
     count: usize,
 ) -> Result<PathBuf, Error> {
-    let params = serde_json::json!({
-        "bench_library": {"output": path, "count": count, "first": first}
-    });
+    let params = library_document(path, first, count);
     let script = path.with_extension("py");
     write_output(&script, assemble(&params, Job::BenchLibrary).as_bytes())?;
     run_script(&Run {

@@ -55,6 +55,10 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/compat.py"),
     ),
     (
+        "contract",
+        include_str!("../../../../blender/gloffuse_blender/contract.py"),
+    ),
+    (
         "furnace",
         include_str!("../../../../blender/gloffuse_blender/furnace.py"),
     ),
@@ -368,9 +372,9 @@ fn parse_import(
 }
 
 /// The modules `entry` needs and `entry` itself, dependencies first, from the package
-/// `modules` plus `extra` (a module outside the package, such as a test's main, as
-/// `(name, text)`); `entry` is a name in either.
-fn bundle_from(
+/// `modules` (`(name, text)`, as `MODULES`) plus `extra` (a module outside the package,
+/// such as a test's main, as `(name, text)`); `entry` is a name in either.
+pub fn bundle_from(
     modules: &[(&str, &str)],
     extra: Option<(&str, &str)>,
     entry: &str,
