@@ -1,8 +1,8 @@
 //! The structure docs/ARCHITECTURE.md describes, checked: which crate may depend on what
 //! (the physics crate, the library and the binary each have their list), which stage may
 //! import which (grouped `use crate::{…}` included), that the library never names a
-//! command-line flag, that a long function says why it is long, and that the module map
-//! names every Rust file.
+//! command-line flag, that a long function (Rust or the Blender-side Python) says why it is long, and that
+//! the module map names every Rust file.
 //!
 //! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
@@ -517,4 +517,71 @@ fn the_module_map_check_can_fail() {
     assert!(!named("src/cli/text.rs"));
     assert!(!named("crates/gloffuse/src/verify/plan.rs"));
     assert!(!named("crates/gloffuse/src/audit/stats.rs"));
+}
+
+/// `def` lines of a Python file whose function runs over `limit` lines without a
+/// `# Long on purpose: why` comment above or inside it. A function ends before the next
+/// line of code indented no deeper than its `def`.
+fn unexplained_long_python_functions(text: &str, limit: usize) -> Vec<(usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let indent_of = |l: &str| l.len() - l.trim_start().len();
+    let mut found = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let trimmed = line.trim_start();
+        if !trimmed.starts_with("def ") {
+            continue;
+        }
+        let indent = indent_of(line);
+        let mut end = i;
+        for (j, l) in lines.iter().enumerate().skip(i + 1) {
+            if l.trim().is_empty() {
+                continue;
+            }
+            if indent_of(l) <= indent && !l.trim_start().starts_with(')') {
+                break;
+            }
+            end = j;
+        }
+        let length = end - i + 1;
+        let explained = lines[i.saturating_sub(1)..=end]
+            .iter()
+            .any(|l| l.trim_start().starts_with("# Long on purpose:"));
+        if length > limit && !explained {
+            found.push((i + 1, length));
+        }
+    }
+    found
+}
+
+#[test]
+fn a_long_python_function_says_why_it_is_long() {
+    let package = root().join("blender/gloffuse_blender");
+    let mut found = Vec::new();
+    let mut checked = 0;
+    for entry in fs::read_dir(&package).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "py") {
+            let text = fs::read_to_string(&path).unwrap();
+            for (line, length) in unexplained_long_python_functions(&text, 80) {
+                found.push(format!("{}:{line} ({length} lines)", path.display()));
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 15, "only {checked} Python modules checked");
+    assert!(
+        found.is_empty(),
+        "functions over 80 lines without a `# Long on purpose:` comment saying why: {found:#?}"
+    );
+}
+
+#[test]
+fn the_python_length_check_can_fail() {
+    let body: String = (0..90).map(|i| format!("    x = {i}\n")).collect();
+    let long = format!("def f():\n{body}\n\ndef g():\n    pass\n");
+    assert_eq!(unexplained_long_python_functions(&long, 80), [(1, 91)]);
+    let explained = format!("# Long on purpose: a table\n{long}");
+    assert!(unexplained_long_python_functions(&explained, 80).is_empty());
+    let short = "def f(\n    a,\n):\n    return a\n\nx = 1\n";
+    assert_eq!(unexplained_long_python_functions(short, 2), [(1, 4)]);
 }

@@ -137,6 +137,110 @@ def _version_pair(value, where):
     raise ValueError("%s: glass_table.from_version must be [major, minor], got %r" % (where, value))
 
 
+def _table_sizes(table, keys, what):
+    """ValueError unless `table` is an object whose `keys` are integers of at least 2."""
+    if not isinstance(table, dict) or not all(
+            isinstance(table.get(k), int) and table.get(k) >= 2 for k in keys):
+        raise ValueError(what)
+
+
+def _check_view(view, where, limit, seen):
+    if not isinstance(view, dict):
+        raise ValueError("%s.view must be an object" % where)
+    present = [key for key in VIEW_GROUPS if view.get(key) is not None]
+    if not present:
+        raise ValueError("%s.view names none of %s" % (where, ", ".join(VIEW_GROUPS)))
+    for key in present:
+        _name(view[key], "%s.view.%s" % (where, key), limit, seen)
+    _name(view.get("image"), "%s.view.image" % where, limit)
+    _table_sizes(view.get("table"), ("width", "height"),
+                 "%s.view.table needs integer width and height of at least 2" % where)
+
+
+def _check_layered(layered, where, limit, seen):
+    if not isinstance(layered, dict):
+        raise ValueError("%s.layered must be an object" % where)
+    _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
+    for key in ("image", "coat_image"):
+        _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
+    coat = layered.get("coat_table")
+    if layered.get("coat_gain_image") is not None:
+        _name(layered["coat_gain_image"], "%s.layered.coat_gain_image" % where, limit)
+        if not isinstance(coat, dict) or "gain" not in coat:
+            raise ValueError("%s.layered.coat_gain_image needs coat_table.gain" % where)
+    _table_sizes(coat, ("size", "slices"),
+                 "%s.layered.coat_table needs integer size and slices of at least 2" % where)
+    if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
+        raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
+
+
+def _check_anisotropic(anisotropic, where, limit, seen):
+    if not isinstance(anisotropic, dict):
+        raise ValueError("%s.anisotropic must be an object" % where)
+    _name(anisotropic.get("shader_group"), "%s.anisotropic.shader_group" % where, limit, seen)
+    _name(anisotropic.get("image"), "%s.anisotropic.image" % where, limit)
+    _table_sizes(anisotropic.get("table"), ("size", "azimuths"),
+                 "%s.anisotropic.table needs integer size and azimuths of at least 2" % where)
+
+
+def _check_glass(glass, where, limit, seen):
+    if not isinstance(glass, dict):
+        raise ValueError("%s.glass must be an object" % where)
+    for key in ("glass_group", "refraction_group"):
+        _name(glass.get(key), "%s.glass.%s" % (where, key), limit, seen)
+    _name(glass.get("image"), "%s.glass.image" % where, limit)
+    table = glass.get("table")
+    _table_sizes(table, ("size", "slices"),
+                 "%s.glass.table needs integer size and slices of at least 2" % where)
+    if finite_list([table.get("ior_max")], "%s.glass.table.ior_max" % where)[0] <= 1.0:
+        raise ValueError("%s.glass.table.ior_max must be above 1" % where)
+    if table.get("glass_group") not in ("gain", "multiscatter"):
+        raise ValueError("%s.glass.table.glass_group is %r; expected 'gain' or "
+                         "'multiscatter'" % (where, table.get("glass_group")))
+
+
+def _check_curve(curve, where):
+    if not isinstance(curve, dict):
+        raise ValueError("%s.curve must be an object" % where)
+    if curve.get("variable") not in CURVE_VARIABLES:
+        raise ValueError("%s.curve.variable is %r; expected 'roughness' or 'alpha'"
+                         % (where, curve.get("variable")))
+    for key in ("numerator", "denominator"):
+        coeffs = finite_list(curve.get(key), "%s.curve.%s" % (where, key))
+        if not any(coeffs):
+            raise ValueError("%s.curve.%s is identically zero" % (where, key))
+
+
+# What each mode adds to a group, and the check of it.
+_MODE_CHECKS = (("view", _check_view), ("layered", _check_layered),
+                ("anisotropic", _check_anisotropic), ("glass", _check_glass))
+
+
+def _check_group(spec, where, limit, seen, normals):
+    if not isinstance(spec, dict):
+        raise ValueError("%s must be an object" % where)
+    if spec.get("distribution") not in DISTRIBUTIONS:
+        raise ValueError("%s.distribution is %r; expected one of %s"
+                         % (where, spec.get("distribution"), ", ".join(DISTRIBUTIONS)))
+    for key in ("correction_group", "shader_group"):
+        _name(spec.get(key), "%s.%s" % (where, key), limit, seen)
+    if spec.get("engine", "cycles") not in ENGINES:
+        raise ValueError("%s.engine is %r; expected one of %s"
+                         % (where, spec.get("engine"), ", ".join(ENGINES)))
+    if any(spec.get(mode) is not None for mode, _ in _MODE_CHECKS) \
+            and spec.get("normal_group") not in normals:
+        # One normal group serves every spec of an engine.
+        _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
+        normals.add(spec["normal_group"])
+    for mode, check in _MODE_CHECKS:
+        if spec.get(mode) is not None:
+            check(spec[mode], where, limit, seen)
+    for key in ("description", "coefficients_source"):
+        if not isinstance(spec.get(key, ""), str):
+            raise ValueError("%s.%s must be a string" % (where, key))
+    _check_curve(spec.get("curve"), where)
+
+
 def validate_params(params):
     """Check the resolved parameters; raise ValueError saying what is wrong."""
     if not isinstance(params, dict):
@@ -151,95 +255,7 @@ def validate_params(params):
     seen = set()
     normals = set()
     for index, spec in enumerate(groups):
-        where = "groups[%d]" % index
-        if not isinstance(spec, dict):
-            raise ValueError("%s must be an object" % where)
-        if spec.get("distribution") not in DISTRIBUTIONS:
-            raise ValueError("%s.distribution is %r; expected one of %s"
-                             % (where, spec.get("distribution"), ", ".join(DISTRIBUTIONS)))
-        for key in ("correction_group", "shader_group"):
-            _name(spec.get(key), "%s.%s" % (where, key), limit, seen)
-        if spec.get("engine", "cycles") not in ENGINES:
-            raise ValueError("%s.engine is %r; expected one of %s"
-                             % (where, spec.get("engine"), ", ".join(ENGINES)))
-        view = spec.get("view")
-        if (view is not None or spec.get("layered") is not None
-                or spec.get("anisotropic") is not None or spec.get("glass") is not None) \
-                and spec.get("normal_group") not in normals:
-            # One normal group serves every spec of an engine.
-            _name(spec.get("normal_group"), "%s.normal_group" % where, limit, seen)
-            normals.add(spec["normal_group"])
-        if view is not None:
-            if not isinstance(view, dict):
-                raise ValueError("%s.view must be an object" % where)
-            present = [key for key in VIEW_GROUPS if view.get(key) is not None]
-            if not present:
-                raise ValueError("%s.view names none of %s" % (where, ", ".join(VIEW_GROUPS)))
-            for key in present:
-                _name(view[key], "%s.view.%s" % (where, key), limit, seen)
-            _name(view.get("image"), "%s.view.image" % where, limit)
-            table = view.get("table")
-            if not isinstance(table, dict) or not all(
-                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("width", "height")):
-                raise ValueError("%s.view.table needs integer width and height of at least 2" % where)
-        layered = spec.get("layered")
-        if layered is not None:
-            if not isinstance(layered, dict):
-                raise ValueError("%s.layered must be an object" % where)
-            _name(layered.get("shader_group"), "%s.layered.shader_group" % where, limit, seen)
-            for key in ("image", "coat_image"):
-                _name(layered.get(key), "%s.layered.%s" % (where, key), limit)
-            coat = layered.get("coat_table")
-            if layered.get("coat_gain_image") is not None:
-                _name(layered["coat_gain_image"], "%s.layered.coat_gain_image" % where, limit)
-                if not isinstance(coat, dict) or "gain" not in coat:
-                    raise ValueError("%s.layered.coat_gain_image needs coat_table.gain" % where)
-            if not isinstance(coat, dict) or not all(
-                    isinstance(coat.get(k), int) and coat.get(k) >= 2 for k in ("size", "slices")):
-                raise ValueError("%s.layered.coat_table needs integer size and slices of at "
-                                 "least 2" % where)
-            if finite_list([coat.get("ior_max")], "%s.layered.coat_table.ior_max" % where)[0] <= 1.0:
-                raise ValueError("%s.layered.coat_table.ior_max must be above 1" % where)
-        anisotropic = spec.get("anisotropic")
-        if anisotropic is not None:
-            if not isinstance(anisotropic, dict):
-                raise ValueError("%s.anisotropic must be an object" % where)
-            _name(anisotropic.get("shader_group"), "%s.anisotropic.shader_group" % where, limit, seen)
-            _name(anisotropic.get("image"), "%s.anisotropic.image" % where, limit)
-            table = anisotropic.get("table")
-            if not isinstance(table, dict) or not all(
-                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "azimuths")):
-                raise ValueError("%s.anisotropic.table needs integer size and azimuths of at "
-                                 "least 2" % where)
-        glass = spec.get("glass")
-        if glass is not None:
-            if not isinstance(glass, dict):
-                raise ValueError("%s.glass must be an object" % where)
-            for key in ("glass_group", "refraction_group"):
-                _name(glass.get(key), "%s.glass.%s" % (where, key), limit, seen)
-            _name(glass.get("image"), "%s.glass.image" % where, limit)
-            table = glass.get("table")
-            if not isinstance(table, dict) or not all(
-                    isinstance(table.get(k), int) and table.get(k) >= 2 for k in ("size", "slices")):
-                raise ValueError("%s.glass.table needs integer size and slices of at least 2" % where)
-            if finite_list([table.get("ior_max")], "%s.glass.table.ior_max" % where)[0] <= 1.0:
-                raise ValueError("%s.glass.table.ior_max must be above 1" % where)
-            if table.get("glass_group") not in ("gain", "multiscatter"):
-                raise ValueError("%s.glass.table.glass_group is %r; expected 'gain' or "
-                                 "'multiscatter'" % (where, table.get("glass_group")))
-        for key in ("description", "coefficients_source"):
-            if not isinstance(spec.get(key, ""), str):
-                raise ValueError("%s.%s must be a string" % (where, key))
-        curve = spec.get("curve")
-        if not isinstance(curve, dict):
-            raise ValueError("%s.curve must be an object" % where)
-        if curve.get("variable") not in CURVE_VARIABLES:
-            raise ValueError("%s.curve.variable is %r; expected 'roughness' or 'alpha'"
-                             % (where, curve.get("variable")))
-        for key in ("numerator", "denominator"):
-            coeffs = finite_list(curve.get(key), "%s.curve.%s" % (where, key))
-            if not any(coeffs):
-                raise ValueError("%s.curve.%s is identically zero" % (where, key))
+        _check_group(spec, "groups[%d]" % index, limit, seen, normals)
     return params
 
 

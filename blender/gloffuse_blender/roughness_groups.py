@@ -104,37 +104,12 @@ def horner_chain(tree, coefficients, x_socket, column, y, prefix, frame):
     return previous, None, used
 
 
-def build_correction_group(spec, params):
-    """The group Roughness, Color -> Color, Gain with Gain = 100 den(x) / num(x)."""
-    tree = reuse_or_create_group(spec["correction_group"])
-    ensure_interface(tree, CORRECTION_SOCKETS)
-    curve = spec["curve"]
+def gain_nodes(tree, frame, num, den, column):
+    """Gain = 100 den / num from the Horner chains' (output, constant) pairs, in the
+    frame from `column` on; a chain that folded to a constant becomes a default
+    value. Returns the gain socket and the column after it."""
+    (num_out, num_const), (den_out, den_const) = num, den
     nodes, links = tree.nodes, tree.links
-
-    group_in = nodes.new("NodeGroupInput")
-    group_in.location = (0.0, 0.0)
-
-    frame = new_frame(tree, "Gain frame", frame_label(curve))
-
-    column = 0
-    x_socket = clamped_roughness(
-        tree, group_in, frame,
-        "r = clamp(Roughness)" if curve["variable"] == "alpha" else "x = clamp(Roughness)")
-    column += 1
-
-    if curve["variable"] == "alpha":
-        square = math_node(tree, "MULTIPLY", "x = alpha = r\u00b2",
-                           (FRAME_INSET + COLUMN_STEP * column, 0.0), frame, "Square")
-        links.new(x_socket, square.inputs[0])
-        links.new(x_socket, square.inputs[1])
-        x_socket = square.outputs[0]
-        column += 1
-
-    num_out, num_const, num_cols = horner_chain(
-        tree, curve["numerator"], x_socket, column, 0.0, "num", frame)
-    den_out, den_const, den_cols = horner_chain(
-        tree, curve["denominator"], x_socket, column, -ROW_STEP, "den", frame)
-    column += max(num_cols, den_cols)
 
     def col_x():
         return FRAME_INSET + COLUMN_STEP * column
@@ -174,6 +149,47 @@ def build_correction_group(spec, params):
         else:
             links.new(num_out, gain.inputs[1])
         gain_out = gain.outputs[0]
+    return gain_out, column
+
+
+def build_correction_group(spec, params):
+    """The group Roughness, Color -> Color, Gain with Gain = 100 den(x) / num(x)."""
+    tree = reuse_or_create_group(spec["correction_group"])
+    ensure_interface(tree, CORRECTION_SOCKETS)
+    curve = spec["curve"]
+    nodes, links = tree.nodes, tree.links
+
+    group_in = nodes.new("NodeGroupInput")
+    group_in.location = (0.0, 0.0)
+
+    frame = new_frame(tree, "Gain frame", frame_label(curve))
+
+    column = 0
+    x_socket = clamped_roughness(
+        tree, group_in, frame,
+        "r = clamp(Roughness)" if curve["variable"] == "alpha" else "x = clamp(Roughness)")
+    column += 1
+
+    if curve["variable"] == "alpha":
+        square = math_node(tree, "MULTIPLY", "x = alpha = r\u00b2",
+                           (FRAME_INSET + COLUMN_STEP * column, 0.0), frame, "Square")
+        links.new(x_socket, square.inputs[0])
+        links.new(x_socket, square.inputs[1])
+        x_socket = square.outputs[0]
+        column += 1
+
+    num_out, num_const, num_cols = horner_chain(
+        tree, curve["numerator"], x_socket, column, 0.0, "num", frame)
+    den_out, den_const, den_cols = horner_chain(
+        tree, curve["denominator"], x_socket, column, -ROW_STEP, "den", frame)
+    column += max(num_cols, den_cols)
+
+    gain_out, column = gain_nodes(tree, frame, (num_out, num_const), (den_out, den_const),
+                                  column)
+
+    def col_x():
+        return FRAME_INSET + COLUMN_STEP * column
+
     column += 1
 
     if params.get("color_model") == "physical":
