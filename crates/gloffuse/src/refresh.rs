@@ -67,7 +67,7 @@ impl RefreshOptions {
 pub fn measure_samples(engine: Engine) -> u32 {
     match engine {
         Engine::Cycles => 64,
-        Engine::Eevee => crate::verify::plan::default_samples(engine, Mode::Roughness),
+        Engine::Eevee => crate::verify::spec(Mode::Roughness).eevee.samples,
     }
 }
 

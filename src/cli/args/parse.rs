@@ -261,3 +261,17 @@ pub(super) fn parse_verdict(s: &str) -> Result<Verdict, String> {
         .find(|v| v.key() == s.trim())
         .ok_or_else(|| format!("invalid verdict '{s}': expected ok, loses, creates or error"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--mode` offers every mode the library has, each once and in its order, so a new mode
+    /// cannot be verified or generated without a choice and its help.
+    #[test]
+    fn the_mode_choices_are_every_mode() {
+        let offered: Vec<Mode> = MODES.iter().map(|c| c.value).collect();
+        assert_eq!(offered, Mode::ALL);
+        assert!(MODES.iter().all(|c| !c.help.is_empty()));
+    }
+}

@@ -5,6 +5,7 @@
 
 pub mod image;
 pub mod judge;
+pub mod modes;
 pub mod notes;
 pub mod plan;
 pub mod predict;
@@ -13,7 +14,9 @@ pub mod stats;
 pub mod verdict;
 
 pub use judge::judge;
-pub use plan::reference_label;
+pub use modes::{
+    ANISOTROPIC_SWEEP, IOR_SWEEP, ModeSpec, SecondAxis, block_roughness, default_roughness, spec,
+};
 pub use plan::{Block, Plan, PlanReference, PlanRow, RenderSettings, Role};
 pub use render::{RenderInfo, Rendered, render};
 pub use verdict::{Judging, Note, ReferenceSphere, Row, Sweep, VerifyReport, WorstSphere};
@@ -35,7 +38,7 @@ pub struct VerifyOptions {
     pub coefficients: Option<String>,
     /// The distributions to check (empty: all the coefficients hold).
     pub distributions: Vec<Distribution>,
-    /// The roughness values of the sweep, each once (empty: the mode's, [`mode_roughness`]).
+    /// The roughness values of the sweep, each once (empty: the mode's, [`ModeSpec::roughness`]).
     pub roughness: Vec<Roughness>,
     /// Layered and glass mode: the indices of refraction, each once, from 1 to
     /// [`coat::IOR_MAX`] (empty: [`IOR_SWEEP`]; every other mode: none).
@@ -47,7 +50,7 @@ pub struct VerifyOptions {
     pub engine: Engine,
     /// Pixels per sphere cell.
     pub cell: u32,
-    /// Samples per pixel (`None`: the mode's and engine's, [`plan::default_samples`]).
+    /// Samples per pixel (`None`: the mode's and engine's, [`ModeSpec::defaults`]).
     pub samples: Option<u32>,
     /// Cycles' random seed.
     pub seed: u32,
@@ -56,8 +59,8 @@ pub struct VerifyOptions {
     pub color: [f64; 3],
     /// What the corrections promise for a colour.
     pub color_model: ColorModel,
-    /// Allowed |mean − 100 %| of a corrected sphere, in percent (`None`: the sweep's,
-    /// [`Judging::for_sweep`]).
+    /// Allowed |mean − 100 %| of a corrected sphere, in percent (`None`: the mode's and
+    /// engine's, [`ModeSpec::defaults`]).
     pub tolerance_percent: Option<f64>,
     /// Allowed |ring mean − 100 %| in the view modes, in percent (`None`: the sweep's).
     pub ring_tolerance_percent: Option<f64>,
@@ -78,71 +81,42 @@ impl VerifyOptions {
     /// The options with each input left unset taken from the mode and engine: the one place
     /// verify's defaults are chosen, for the command line and every other caller.
     pub fn resolve(&self) -> Resolved {
-        let (mode, engine) = (self.mode, self.engine);
+        let spec = spec(self.mode);
+        let defaults = spec.defaults(self.engine);
         let given_or = |given: &[f64], default: &[f64]| match given.is_empty() {
             true => default.to_vec(),
             false => given.to_vec(),
         };
-        let judging = Judging::for_sweep(engine, mode);
         Resolved {
             roughness: match self.roughness.is_empty() {
-                true => mode_roughness(mode),
+                true => (spec.roughness)(),
                 false => self.roughness.clone(),
             },
-            ior: match mode {
-                Mode::Layered | Mode::Glass => given_or(&self.ior, &IOR_SWEEP),
+            ior: match spec.axis {
+                SecondAxis::Ior(sweep) => given_or(&self.ior, sweep),
                 _ => self.ior.clone(),
             },
-            anisotropy: match mode {
-                Mode::Anisotropic => given_or(&self.anisotropy, &ANISOTROPIC_SWEEP),
+            anisotropy: match spec.axis {
+                SecondAxis::Anisotropy(sweep) => given_or(&self.anisotropy, sweep),
                 _ => self.anisotropy.clone(),
             },
             render: RenderSettings {
                 cell: self.cell,
-                samples: self.samples.unwrap_or(plan::default_samples(engine, mode)),
+                samples: self.samples.unwrap_or(defaults.samples),
                 seed: self.seed,
-                ..RenderSettings::for_engine(engine)
+                ..RenderSettings::for_engine(self.engine)
             },
             judging: Judging {
-                tolerance_percent: self.tolerance_percent.unwrap_or(judging.tolerance_percent),
+                tolerance_percent: self
+                    .tolerance_percent
+                    .unwrap_or(defaults.judging.tolerance_percent),
                 ring_tolerance_percent: self
                     .ring_tolerance_percent
-                    .unwrap_or(judging.ring_tolerance_percent),
+                    .unwrap_or(defaults.judging.ring_tolerance_percent),
             },
         }
     }
 }
-
-/// The roughness values a sweep of `mode` checks unless told: the layered, anisotropic and
-/// glass tables' sweep is shorter, each of its rows being repeated per index or anisotropy.
-pub fn mode_roughness(mode: Mode) -> Vec<Roughness> {
-    match mode {
-        Mode::Layered | Mode::Anisotropic | Mode::Glass => block_roughness(),
-        Mode::Roughness | Mode::View | Mode::Multiscatter => default_roughness(),
-    }
-}
-
-/// The verify sweep's roughness values: 0, 0.1, …, 1.
-pub fn default_roughness() -> Vec<Roughness> {
-    Roughness::grid(11)
-}
-
-/// The layered and anisotropic sweeps' roughness values: 0.1, 0.25, 0.5, 0.75, 1 (a smooth
-/// lobe is a mirror, which the tables hold exactly).
-pub fn block_roughness() -> Vec<Roughness> {
-    [0.1, 0.25, 0.5, 0.75, 1.0]
-        .map(|r| Roughness::new(r).expect("in [0, 1]"))
-        .to_vec()
-}
-
-/// The layered and glass sweeps' indices of refraction: water, glass, and a dense flint.
-/// Not diamond's 2.4 by default: there a rough solid glass sphere's noise needs about
-/// 1,024 spp (`--ior 2.4`).
-pub const IOR_SWEEP: [f64; 3] = [1.33, 1.5, 2.0];
-
-/// The anisotropic sweep's anisotropies: a moderate and a strong stretch along the tangent,
-/// and a strong one across it (a negative anisotropy swaps the widths).
-pub const ANISOTROPIC_SWEEP: [f64; 3] = [0.5, 0.9, -0.9];
 
 impl Default for VerifyOptions {
     fn default() -> Self {
@@ -238,20 +212,20 @@ fn check_options(v: &VerifyOptions, resolved: &Resolved) -> Result<(), Error> {
     check_anisotropy(v.mode, &resolved.anisotropy)?;
     check_engine(v.engine, v.mode)?;
     check_color_model(v.mode, v.color_model)?;
-    check_glass_color(v.mode, v.color)
+    check_white(v.mode, v.color)
 }
 
-/// Glass mode's spheres are white: a coloured glass tints light at every surface it
-/// crosses, so a solid sphere's colour in the furnace has no closed form to judge by.
-fn check_glass_color(mode: Mode, color: [f64; 3]) -> Result<(), Error> {
-    if mode == Mode::Glass && color != [1.0; 3] {
+/// A colour the mode's spheres may take (glass's are white).
+fn check_white(mode: Mode, color: [f64; 3]) -> Result<(), Error> {
+    if let Some(why) = spec(mode).white_only
+        && color != [1.0; 3]
+    {
         let text: Vec<String> = color.iter().map(|c| c.to_string()).collect();
         return Err(Error::input(
             Field::Color,
             text.join(","),
             Hint::new(
-                "1,1,1 with {} glass (a coloured glass tints light at every surface it \
-                 crosses, so a solid sphere's colour has no closed form to judge by)",
+                format!("1,1,1 with {{}} {} ({why})", mode.key()),
                 [Field::Mode],
             ),
         ));
@@ -266,48 +240,20 @@ fn blocks(resolved: &Resolved) -> Vec<Block> {
         .collect()
 }
 
-/// EEVEE renders the roughness and view modes; the layered groups are Cycles' only (in
-/// EEVEE's furnace their rings miss 2 %), EEVEE ignores anisotropy, and the glass groups
-/// restore Cycles' glass.
+/// An engine the mode renders in (EEVEE renders the roughness and view modes only).
 fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
-    let why = match mode {
-        Mode::Layered => {
-            "the layered groups are calibrated for Cycles; in EEVEE's furnace their rings \
-             miss 2 %, docs/EEVEE.md"
-        }
-        Mode::Anisotropic => {
-            "EEVEE renders an anisotropic Glossy as an isotropic one, docs/EEVEE.md"
-        }
-        Mode::Glass => {
-            "the glass groups restore the energy of Cycles' Glass BSDF; EEVEE renders glass \
-             its own way, docs/EEVEE.md"
-        }
-        _ => return Ok(()),
-    };
-    if engine == Engine::Eevee {
+    let spec = spec(mode);
+    if !spec.engines.contains(&engine) {
+        let allowed: Vec<&str> = spec.engines.iter().map(|e| e.key()).collect();
         return Err(Error::input(
             Field::Engine,
             engine.key(),
             Hint::new(
-                format!("cycles with {{}} {} ({why})", mode.key()),
-                [Field::Mode],
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// The anisotropic and glass groups keep the colour exact (colour / E); no other promise is
-/// judged.
-fn check_color_model(mode: Mode, model: ColorModel) -> Result<(), Error> {
-    if matches!(mode, Mode::Anisotropic | Mode::Glass) && model != ColorModel::Exact {
-        return Err(Error::input(
-            Field::ColorModel,
-            model.key(),
-            Hint::new(
                 format!(
-                    "exact with {{}} {} (its groups multiply the colour by 1/E)",
-                    mode.key()
+                    "{} with {{}} {} ({})",
+                    allowed.join(" or "),
+                    mode.key(),
+                    spec.other_engines_refused
                 ),
                 [Field::Mode],
             ),
@@ -316,16 +262,42 @@ fn check_color_model(mode: Mode, model: ColorModel) -> Result<(), Error> {
     Ok(())
 }
 
-/// Anisotropic mode's anisotropies are each given once and in [−0.99, 0.99] (what Cycles
-/// clamps to); every other mode takes none.
+/// A colour model the mode's groups promise (the anisotropic and glass groups keep the
+/// colour exact, colour / E); no other promise is judged.
+fn check_color_model(mode: Mode, model: ColorModel) -> Result<(), Error> {
+    let spec = spec(mode);
+    if !spec.color_models.contains(&model) {
+        let allowed: Vec<&str> = spec.color_models.iter().map(|m| m.key()).collect();
+        return Err(Error::input(
+            Field::ColorModel,
+            model.key(),
+            Hint::new(
+                format!(
+                    "{} with {{}} {} ({})",
+                    allowed.join(" or "),
+                    mode.key(),
+                    spec.other_color_models_refused
+                ),
+                [Field::Mode],
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The anisotropies of a mode that sweeps them (anisotropic) are each given once and in
+/// [−0.99, 0.99] (what Cycles clamps to); every other mode takes none.
 fn check_anisotropy(mode: Mode, anisotropy: &[f64]) -> Result<(), Error> {
-    if mode != Mode::Anisotropic {
+    if !spec(mode).takes_anisotropy() {
         return match anisotropy.first() {
             Some(a) => Err(Error::input(
                 Field::Anisotropy,
                 a,
                 Hint::new(
-                    "no anisotropy: {} goes with {} anisotropic",
+                    format!(
+                        "no anisotropy: {{}} goes with {{}} {}",
+                        modes_taking(ModeSpec::takes_anisotropy)
+                    ),
                     [Field::Anisotropy, Field::Mode],
                 ),
             )),
@@ -358,16 +330,20 @@ pub fn check_color(color: [f64; 3]) -> Result<(), Error> {
     ))
 }
 
-/// Layered and glass mode's indices of refraction are each given once and within the
-/// tables (the coat's and the glass's share their axis); every other mode takes none.
+/// The indices of refraction of a mode that sweeps them (layered, glass) are each given
+/// once and within the tables (the coat's and the glass's share their axis); every other
+/// mode takes none.
 fn check_ior(mode: Mode, ior: &[f64]) -> Result<(), Error> {
-    if !matches!(mode, Mode::Layered | Mode::Glass) {
+    if !spec(mode).takes_ior() {
         return match ior.first() {
             Some(n) => Err(Error::input(
                 Field::Ior,
                 n,
                 Hint::new(
-                    "no index of refraction: {} goes with {} layered or glass",
+                    format!(
+                        "no index of refraction: {{}} goes with {{}} {}",
+                        modes_taking(ModeSpec::takes_ior)
+                    ),
                     [Field::Ior, Field::Mode],
                 ),
             )),
@@ -385,6 +361,16 @@ fn check_ior(mode: Mode, ior: &[f64]) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// The modes whose spec answers yes, for a hint: `layered or glass`.
+fn modes_taking(takes: fn(&ModeSpec) -> bool) -> String {
+    let keys: Vec<&str> = Mode::ALL
+        .into_iter()
+        .filter(|&m| takes(spec(m)))
+        .map(Mode::key)
+        .collect();
+    keys.join(" or ")
 }
 
 fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {

@@ -14,6 +14,8 @@ use std::path::Path;
 use crate::generate::{GenerateParams, GroupSpec, Mode};
 use crate::measure::{Distribution, Engine, Roughness};
 
+use super::modes::spec;
+
 /// What a sphere is shaded with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case", tag = "kind", content = "distribution")]
@@ -31,16 +33,14 @@ pub enum Role {
 }
 
 impl Role {
-    /// How a report names the spheres of this role in `mode`.
+    /// How a report names the spheres of this role in `mode` (`GGX Mix Shader`).
     pub fn label(self, mode: Mode) -> String {
-        match (self, mode) {
-            (Role::Uncorrected(d), Mode::Layered) => format!("{} Mix Shader", d.label()),
-            (Role::Uncorrected(d), Mode::Glass) => format!("{} Glass BSDF", d.label()),
-            (Role::Corrected(d), Mode::Layered) => format!("{} layered", d.label()),
-            (Role::Uncorrected(d), _) => format!("{} uncorrected", d.label()),
-            (Role::Corrected(d), _) => format!("{} corrected", d.label()),
-            (Role::Reference, _) => reference_label(mode).to_string(),
-            (Role::Lighting, _) => "Diffuse BSDF".to_string(),
+        let spec = spec(mode);
+        match self {
+            Role::Uncorrected(d) => format!("{} {}", d.label(), spec.uncorrected),
+            Role::Corrected(d) => format!("{} {}", d.label(), spec.corrected),
+            Role::Reference => spec.reference.to_string(),
+            Role::Lighting => "Diffuse BSDF".to_string(),
         }
     }
 }
@@ -76,15 +76,6 @@ impl Block {
             Block::Ior(n) => format!("IOR {n}"),
             Block::Anisotropy(a) => format!("anisotropy {a}"),
         }
-    }
-}
-
-/// The reference spheres' shader in `mode`.
-pub fn reference_label(mode: Mode) -> &'static str {
-    match mode {
-        Mode::Layered => "Principled BSDF",
-        Mode::Glass => "Multiscatter GGX glass",
-        _ => "Multiscatter GGX",
     }
 }
 
@@ -152,23 +143,10 @@ impl RenderSettings {
         RenderSettings {
             engine,
             cell: 64,
-            samples: default_samples(engine, Mode::Roughness),
+            samples: spec(Mode::Roughness).defaults(engine).samples,
             seed: 0,
             radius_fraction: 0.9,
         }
-    }
-}
-
-/// Samples per pixel unless told: Cycles 32 keeps the standard error of every sphere's mean
-/// ≤ 0.2 % (measured in 3.4, 4.5 and 5.0 over six seeds; 16 spp reaches 0.5 % in 3.4).
-/// A solid glass sphere is far noisier (its light crosses many surfaces, each multiplying
-/// its weight): at 128 spp GGX r 1 IOR 2 scatters by 0.9 %, so glass takes 256 (5.0.1).
-/// EEVEE's furnace is deterministic: 1, 64 and 256 samples agree within 0.03 %.
-pub fn default_samples(engine: Engine, mode: Mode) -> u32 {
-    match (engine, mode) {
-        (Engine::Cycles, Mode::Glass) => 256,
-        (Engine::Cycles, _) => 32,
-        (Engine::Eevee, _) => 1,
     }
 }
 
@@ -311,7 +289,7 @@ impl Plan {
             generate: groups.clone(),
             furnace: FurnaceSection {
                 engine: self.settings.engine,
-                solid: mode == Mode::Glass,
+                solid: spec(mode).solid,
                 cell: self.settings.cell,
                 columns: self.columns,
                 samples: self.settings.samples,
@@ -328,7 +306,8 @@ impl Plan {
 
 /// What a cell's sphere is shaded with in `mode`; `group` names a distribution's group.
 fn sphere_spec(c: &Cell, mode: Mode, group: &dyn Fn(Distribution) -> String) -> SphereSpec {
-    let glass = mode == Mode::Glass;
+    // A solid sphere's plain and reference cells are Glass BSDFs.
+    let glass = spec(mode).solid;
     let anisotropy = c.block.and_then(Block::anisotropy);
     match (c.role, c.block.and_then(Block::ior)) {
         (Role::Uncorrected(d), Some(ior)) if glass => SphereSpec::Glass {

@@ -2,6 +2,7 @@
 //! looked at: what the colour model promises the spheres (as a whole and ring by ring), and
 //! what the uncorrected and corrected spheres should render relative to that.
 
+use super::modes::spec;
 use super::plan::Block;
 use crate::fit::Curve;
 use crate::generate::{ColorModel, Mode};
@@ -61,7 +62,7 @@ impl Predictor {
         if let Some(a) = block.and_then(Block::anisotropy) {
             return self.predict_anisotropic(d, r, a, rings.len());
         }
-        if self.mode == Mode::Glass {
+        if spec(self.mode).solid {
             return self.predict_glass(rings.len());
         }
         let ior = block.and_then(Block::ior);
@@ -181,7 +182,7 @@ impl Predictor {
     /// what a corrected GGX sphere does, Principled BSDF (at the block's index) what a
     /// layered GGX coat does, Multiscatter GGX glass (white) all the light.
     pub fn reference_target(&self, r: Roughness, block: Option<Block>) -> [f64; 3] {
-        if self.mode == Mode::Glass {
+        if spec(self.mode).solid {
             return self.color;
         }
         let ggx = self.engine.glossy(Distribution::Ggx, self.masking, r);

@@ -16,7 +16,8 @@ use crate::measure::{BlenderVersion, Distribution, Engine, Masking, Roughness};
 /// mean scatters by ±2 % in multiscatter mode, while at 512 spp every ring is within 0.3 %).
 pub const MIN_RING_PIXELS: usize = 150;
 
-/// The thresholds a corrected sphere is judged by.
+/// The thresholds a corrected sphere is judged by (each mode's and engine's defaults:
+/// [`super::ModeSpec::defaults`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Judging {
     /// Allowed |mean − 100 %| of a corrected sphere, in percent.
@@ -28,40 +29,7 @@ pub struct Judging {
 
 impl Default for Judging {
     fn default() -> Self {
-        Judging::for_engine(Engine::Cycles)
-    }
-}
-
-impl Judging {
-    /// The thresholds of a sweep of `mode` in `engine`: glass mode's are wider (±2 % per
-    /// sphere, ±3 % per ring, the goal it was built to): a solid glass sphere's noise is
-    /// heavy-tailed, its standard error falling only about as n^-1/3 with the samples
-    /// (GGX r 1 IOR 2.4 in 5.0.1: 1.2 % at 128 spp, 0.6 % at 1,024).
-    pub fn for_sweep(engine: Engine, mode: Mode) -> Self {
-        match mode {
-            Mode::Glass => Judging {
-                tolerance_percent: 2.0,
-                ring_tolerance_percent: 3.0,
-            },
-            _ => Judging::for_engine(engine),
-        }
-    }
-
-    pub fn for_engine(engine: Engine) -> Self {
-        match engine {
-            Engine::Cycles => Judging {
-                // 1 %: five times the largest standard error of a sphere's mean at 32 spp.
-                tolerance_percent: 1.0,
-                // 1.5 %: a ring holds fewer pixels than a sphere, so it is noisier.
-                ring_tolerance_percent: 1.5,
-            },
-            // EEVEE has no noise but its own errors: Next's lighting is 0.8 % dark, and
-            // its split-sum table is within 0.5 % of the integrator's.
-            Engine::Eevee => Judging {
-                tolerance_percent: 2.0,
-                ring_tolerance_percent: 2.0,
-            },
-        }
+        super::spec(Mode::Roughness).cycles.judging
     }
 }
 
@@ -149,7 +117,7 @@ pub struct ReferenceSphere {
 impl ReferenceSphere {
     /// `Multiscatter GGX`, or in layered mode `Principled BSDF, IOR 1.5`.
     pub fn series(&self, mode: Mode) -> String {
-        series_name(super::plan::reference_label(mode), self.block)
+        series_name(super::spec(mode).reference, self.block)
     }
 }
 

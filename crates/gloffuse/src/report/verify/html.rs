@@ -10,7 +10,7 @@ use super::{deviation, words};
 use crate::report::page::{FAIL_COLOUR, PASS_COLOUR, banner, escape, page_css};
 use crate::report::{false_colour, png};
 use crate::verify::verdict::MIN_RING_PIXELS;
-use crate::verify::{Rendered, Row, VerifyReport, reference_label};
+use crate::verify::{Rendered, Row, VerifyReport, spec};
 
 /// `rerun` is the command line that reproduces the whole check (the CLI passes its own);
 /// `files` are the report's other files, linked by name.
@@ -98,7 +98,7 @@ fn write_thresholds(s: &mut String, report: &VerifyReport) {
         "<h2>What is judged</h2><p class=\"scope\">{}</p><ul>\
          <li><b>tolerance</b>: every channel of a corrected sphere's mean within ±{} % of its target; {}.</li>\
          {rings}<li>The <b>predicted</b> column: {}.</li></ul>",
-        escape(words::scope(report.mode)),
+        escape(spec(report.mode).scope),
         report.tolerance_percent,
         escape(&words::target(report)),
         escape(words::PREDICTED),
@@ -148,7 +148,7 @@ pub const PLOT: &str = "brightness.png";
 fn write_spheres(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
     // Layered mode compares the hand-made Mix Shader with the layered group, glass mode
     // Blender's Glass BSDF with the glass group.
-    let (plain, fixed) = words::sphere_names(report.mode);
+    let (plain, fixed) = (spec(report.mode).uncorrected, spec(report.mode).corrected);
     let (ring, deviation) = if report.mode.per_pixel() {
         ("worst ring", String::new())
     } else {
@@ -228,7 +228,7 @@ fn write_reference(s: &mut String, report: &VerifyReport, rendered: &Rendered) {
     let _ = writeln!(
         s,
         "<h2>Reference: Blender's {}</h2><table><tr><th>sphere</th><th>r</th><th>brightness</th><th>±SE</th><th>sphere</th></tr>",
-        reference_label(report.mode)
+        spec(report.mode).reference
     );
     for r in &report.reference {
         let _ = writeln!(

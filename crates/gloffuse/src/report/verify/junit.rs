@@ -8,7 +8,6 @@ use quick_junit::{NonSuccessKind, Property, Report, TestCase, TestCaseStatus, Te
 
 use crate::report::escape::{xml_attribute, xml_text};
 
-use crate::generate::Mode;
 use crate::verify::{Row, VerifyReport};
 
 /// `rerun` is the command line that reproduces the whole check (the CLI passes its own).
@@ -18,7 +17,7 @@ pub fn render(report: &VerifyReport, rerun: &str) -> String {
     add_suite_properties(&mut suite, report);
     for row in &report.rows {
         suite.add_test_case(mean_case(report, row, rerun));
-        if mode_rings(report.mode) {
+        if report.mode.per_pixel() {
             suite.add_test_case(rings_case(report, row, rerun));
         }
     }
@@ -130,9 +129,4 @@ fn sphere_name(row: &Row) -> String {
 
 fn classname(report: &VerifyReport) -> String {
     format!("gloffuse.verify.{}", report.mode.key())
-}
-
-/// The view modes judge rings as well as means.
-fn mode_rings(mode: Mode) -> bool {
-    mode != Mode::Roughness
 }

@@ -8,13 +8,13 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::words;
 use crate::error::Error;
 use crate::generate::Mode;
 use crate::measure::Distribution;
 use crate::report::png::{FAMILY, backend, register_font, write_error, write_png};
 use crate::verify::VerifyReport;
-use crate::verify::plan::{Block, reference_label};
+use crate::verify::plan::Block;
+use crate::verify::spec;
 
 /// Size of the brightness plot in pixels.
 pub const PLOT_SIZE: (u32, u32) = (900, 820);
@@ -199,16 +199,15 @@ fn plot_title(report: &VerifyReport, plotted: Option<Block>) -> String {
     match plotted {
         Some(Block::Ior(n)) => format!(
             "{} furnace brightness · Blender {} · IOR {n} · {} spp",
-            match report.mode {
-                Mode::Glass => "Solid glass",
-                _ => "Layered",
-            },
+            spec(report.mode).block_plot_title,
             report.render.blender_version,
             report.render.samples
         ),
         Some(Block::Anisotropy(a)) => format!(
-            "Anisotropic furnace brightness · Blender {} · anisotropy {a} · {} spp",
-            report.render.blender_version, report.render.samples
+            "{} furnace brightness · Blender {} · anisotropy {a} · {} spp",
+            spec(report.mode).block_plot_title,
+            report.render.blender_version,
+            report.render.samples
         ),
         None => format!(
             "Furnace brightness · Blender {} · coefficients {} · {} spp",
@@ -378,7 +377,7 @@ fn draw_distribution<DB: DrawingBackend>(
             .map(|&p| Circle::new(p, 4, c.stroke_width(2))),
     )?;
     chart.draw_series(corrected.iter().map(|&p| Circle::new(p, 4, c.filled())))?;
-    let (uncorrected_name, corrected_name) = words::sphere_names(mode);
+    let (uncorrected_name, corrected_name) = (spec(mode).uncorrected, spec(mode).corrected);
     let mut legend = vec![
         Legend::Heading(d.label().to_string(), c),
         Legend::Entry(Key::Hollow(c), format!("{uncorrected_name}, rendered")),
@@ -414,10 +413,7 @@ fn draw_reference<DB: DrawingBackend>(
     )?;
     Ok([
         Legend::Heading("Reference".into(), REFERENCE_COLOUR),
-        Legend::Entry(
-            Key::Triangle(REFERENCE_COLOUR),
-            reference_label(mode).into(),
-        ),
+        Legend::Entry(Key::Triangle(REFERENCE_COLOUR), spec(mode).reference.into()),
     ])
 }
 

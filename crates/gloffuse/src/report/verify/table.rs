@@ -2,9 +2,9 @@
 
 use std::fmt::Write as _;
 
-use crate::generate::{ColorModel, Mode};
+use crate::generate::ColorModel;
 use crate::measure::Engine;
-use crate::verify::VerifyReport;
+use crate::verify::{VerifyReport, spec};
 
 use super::words;
 
@@ -13,20 +13,16 @@ use super::words;
 pub fn render(report: &VerifyReport) -> String {
     let mut s = String::new();
     write_title(&mut s, report);
-    let layered = report.mode == Mode::Layered;
+    let spec = spec(report.mode);
     // Rows with an index name it too ("Ashikhmin-Shirley, IOR 1.33"), and so do the
     // references ("Multiscatter GGX glass, IOR 1.5").
-    let w = if matches!(report.mode, Mode::Layered | Mode::Glass) {
-        32
-    } else {
-        18
-    };
-    if let Some(legend) = legend(report.mode) {
+    let w = if spec.takes_ior() { 32 } else { 18 };
+    if let Some(legend) = spec.legend {
         let _ = writeln!(s, "{legend}");
     }
     // An EEVEE sweep shows, beside each plain sphere, what Cycles renders for it.
     let eevee = report.engine == Engine::Eevee;
-    write_column_names(&mut s, w, layered, eevee);
+    write_column_names(&mut s, w, spec.row_heading, eevee);
     write_spheres(&mut s, report, w, eevee);
     write_references(&mut s, report, w, eevee);
     write_verdict(&mut s, report);
@@ -38,22 +34,6 @@ pub fn render(report: &VerifyReport) -> String {
         let _ = writeln!(s, "log: {}\nrerun: {}", i.log, i.command);
     }
     s
-}
-
-/// What the spheres of a mode are, where the column names do not say it.
-fn legend(mode: Mode) -> Option<&'static str> {
-    match mode {
-        Mode::Layered => Some(
-            "uncorrected = Mix Shader(Fresnel(IOR), Diffuse, Glossy) as artists build it; \
-             corrected = Gloffuse Layered; reference = Principled BSDF; percentages are of \
-             what the layered coat promises",
-        ),
-        Mode::Glass => Some(
-            "solid spheres, 1,024 bounces: uncorrected = Blender's Glass BSDF; corrected = \
-             Gloffuse Glass; reference = Multiscatter GGX glass",
-        ),
-        _ => None,
-    }
 }
 
 /// How the sweep was rendered, and in which colour when it is not plain white.
@@ -82,11 +62,11 @@ fn write_title(s: &mut String, report: &VerifyReport) {
 }
 
 /// The table's header line; the first column `w` wide.
-fn write_column_names(s: &mut String, w: usize, layered: bool, eevee: bool) {
+fn write_column_names(s: &mut String, w: usize, row_heading: &str, eevee: bool) {
     let _ = writeln!(
         s,
         "{:<w$} {:>5} {:>12}{} {:>11} {:>7} {:>10} {:>7} {:>8}  status",
-        if layered { "coat" } else { "distribution" },
+        row_heading,
         "r",
         "uncorrected",
         if eevee {
@@ -149,8 +129,9 @@ fn write_verdict(s: &mut String, report: &VerifyReport) {
         words::target(report),
         words::PREDICTED
     );
-    if report.mode == Mode::Roughness {
-        let _ = writeln!(s, "{}", words::scope(report.mode));
+    // Where the rings are not judged, the table says why they look off target.
+    if !report.mode.per_pixel() {
+        let _ = writeln!(s, "{}", spec(report.mode).scope);
     }
 }
 
