@@ -183,29 +183,8 @@ impl GenerateParams {
             Curves::Pinned { coefficients, .. } => vec![coefficients.engine()],
             Curves::Presets(engines) => engines.to_vec(),
         };
-        if engines.contains(&Engine::Eevee) && modes.contains(&Mode::Layered) {
-            return Err(Error::input(
-                Field::Mode,
-                Mode::Layered.key(),
-                "roughness, view or multiscatter for EEVEE: the layered groups are calibrated \
-                 for Cycles, and in EEVEE's furnace their rings miss 2 % (docs/EEVEE.md)",
-            ));
-        }
-        if engines.contains(&Engine::Eevee) && modes.contains(&Mode::Anisotropic) {
-            return Err(Error::input(
-                Field::Mode,
-                Mode::Anisotropic.key(),
-                "roughness, view or multiscatter for EEVEE: EEVEE renders an anisotropic \
-                 Glossy as an isotropic one, so the anisotropic groups are built for Cycles only",
-            ));
-        }
-        if engines.contains(&Engine::Eevee) && modes.contains(&Mode::Glass) {
-            return Err(Error::input(
-                Field::Mode,
-                Mode::Glass.key(),
-                "roughness, view or multiscatter for EEVEE: the glass groups restore the \
-                 energy of Cycles' Glass and Refraction BSDFs, which EEVEE does not render",
-            ));
+        if engines.contains(&Engine::Eevee) {
+            check_eevee_modes(modes)?;
         }
         let mut groups = Vec::new();
         for engine in engines {
@@ -270,6 +249,29 @@ fn engine_families(engine: Engine, families: &[Masking]) -> Vec<Masking> {
     rendered
 }
 
+/// Each of `modes` is built for EEVEE, or the first in `Mode::ALL`'s order that is not is
+/// refused, naming those that are.
+fn check_eevee_modes(modes: &[Mode]) -> Result<(), Error> {
+    let Some((mode, why)) = Mode::ALL
+        .into_iter()
+        .filter(|m| modes.contains(m))
+        .find_map(|m| Some((m, m.cycles_only()?)))
+    else {
+        return Ok(());
+    };
+    let eevee: Vec<&str> = Mode::ALL
+        .into_iter()
+        .filter(|m| m.cycles_only().is_none())
+        .map(Mode::key)
+        .collect();
+    let (last, rest) = eevee.split_last().expect("some modes render in EEVEE");
+    Err(Error::input(
+        Field::Mode,
+        mode.key(),
+        format!("{} or {last} for EEVEE: {why}", rest.join(", ")),
+    ))
+}
+
 /// One distribution's groups for one engine: names, and per family the curve and the tables
 /// of the BSDF that engine renders.
 fn group_spec(
@@ -280,11 +282,9 @@ fn group_spec(
     color_model: ColorModel,
 ) -> GroupSpec {
     let wants = |m: Mode| modes.contains(&m);
-    // Every per-pixel group reads the shading normal; all but the anisotropic one E(μ, r).
+    // Every per-pixel group reads the shading normal; those of `reads_view_table` E(μ, r).
     let normal = modes.iter().any(|m| m.per_pixel());
-    let views = modes
-        .iter()
-        .any(|m| m.per_pixel() && !matches!(m, Mode::Anisotropic | Mode::Glass));
+    let views = modes.iter().any(|m| m.reads_view_table());
     let layered = wants(Mode::Layered);
     // Anisotropic GGX and Beckmann (Ashikhmin–Shirley's anisotropic lobe is another model).
     let anisotropic = wants(Mode::Anisotropic) && d != Distribution::AshikhminShirley;
@@ -428,4 +428,26 @@ fn in_the_other_engine(engine: Engine, d: Distribution, masking: Masking) -> Str
 }
 fn as_blender_enum<S: serde::Serializer>(d: &Distribution, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(d.blender_enum())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// EEVEE takes the modes whose groups are built for it; of the others the first in
+    /// `Mode::ALL`'s order is refused, naming the modes EEVEE takes and why.
+    #[test]
+    fn eevee_refuses_the_cycles_only_modes() {
+        assert!(check_eevee_modes(&[Mode::Roughness, Mode::View, Mode::Multiscatter]).is_ok());
+        let refused = check_eevee_modes(&[Mode::Glass, Mode::Layered]).unwrap_err();
+        let text = refused.to_string();
+        assert!(text.contains("layered"), "{text}");
+        assert!(
+            text.contains(
+                "roughness, view or multiscatter for EEVEE: the layered groups are calibrated \
+                 for Cycles, and in EEVEE's furnace their rings miss 2 % (docs/EEVEE.md)"
+            ),
+            "{text}"
+        );
+    }
 }

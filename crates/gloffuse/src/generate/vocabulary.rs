@@ -3,6 +3,8 @@
 
 use serde::Serialize;
 
+use crate::measure::Engine;
+
 /// Which correction a shader group applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -50,6 +52,39 @@ impl Mode {
     /// the sphere's mean, is judged)?
     pub fn per_pixel(self) -> bool {
         self != Mode::Roughness
+    }
+
+    /// Why this mode's groups are built for Cycles only (`None`: for EEVEE too).
+    pub fn cycles_only(self) -> Option<&'static str> {
+        match self {
+            Mode::Roughness | Mode::View | Mode::Multiscatter => None,
+            Mode::Layered => Some(
+                "the layered groups are calibrated for Cycles, and in EEVEE's furnace their \
+                 rings miss 2 % (docs/EEVEE.md)",
+            ),
+            Mode::Anisotropic => Some(
+                "EEVEE renders an anisotropic Glossy as an isotropic one, so the anisotropic \
+                 groups are built for Cycles only",
+            ),
+            Mode::Glass => Some(
+                "the glass groups restore the energy of Cycles' Glass and Refraction BSDFs, \
+                 which EEVEE does not render",
+            ),
+        }
+    }
+
+    /// The engines this mode's groups are built for.
+    pub fn engines(self) -> &'static [Engine] {
+        match self.cycles_only() {
+            Some(_) => &[Engine::Cycles],
+            None => &[Engine::Cycles, Engine::Eevee],
+        }
+    }
+
+    /// Does this mode's group read the isotropic view table E(μ, r) (the anisotropic and
+    /// glass groups read their own tables instead)?
+    pub fn reads_view_table(self) -> bool {
+        matches!(self, Mode::View | Mode::Multiscatter | Mode::Layered)
     }
 }
 

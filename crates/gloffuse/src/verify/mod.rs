@@ -242,9 +242,8 @@ fn blocks(resolved: &Resolved) -> Vec<Block> {
 
 /// An engine the mode renders in (EEVEE renders the roughness and view modes only).
 fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
-    let spec = spec(mode);
-    if !spec.engines.contains(&engine) {
-        let allowed: Vec<&str> = spec.engines.iter().map(|e| e.key()).collect();
+    if !mode.engines().contains(&engine) {
+        let allowed: Vec<&str> = mode.engines().iter().map(|e| e.key()).collect();
         return Err(Error::input(
             Field::Engine,
             engine.key(),
@@ -253,7 +252,7 @@ fn check_engine(engine: Engine, mode: Mode) -> Result<(), Error> {
                     "{} with {{}} {} ({})",
                     allowed.join(" or "),
                     mode.key(),
-                    spec.other_engines_refused
+                    spec(mode).other_engines_refused
                 ),
                 [Field::Mode],
             ),

@@ -1,9 +1,10 @@
 //! Each mode's verify facts in one table, one entry a mode ([`spec`]): the sweep it renders
 //! unless told (roughness values and the second axis), samples and thresholds per engine,
-//! the engines and colour models it takes, whether its spheres are coloured or solid, and
-//! the words the reports call its spheres by. Verify's checks, plan and judging, and the
-//! reports, read these facts here; the physics of a mode stays where it is computed
-//! (`predict.rs`) and asks the spec a named question (`solid`).
+//! why it refuses the engines its groups are not built for and the colour models it takes,
+//! whether its spheres are white or solid, and the words the reports call its spheres by.
+//! Verify's checks, plan and judging, and the reports, read these facts here; the generate
+//! facts (key, per-pixel, engines) are `Mode`'s own; the physics of a mode stays where it
+//! is computed (`predict.rs`) and asks the spec a named question (`solid`).
 
 use crate::generate::{ColorModel, Mode};
 use crate::measure::{Engine, Roughness};
@@ -22,8 +23,8 @@ pub struct ModeSpec {
     /// since the options resolve before they are checked).
     pub cycles: EngineDefaults,
     pub eevee: EngineDefaults,
-    /// The engines that render the mode, and why the others are refused.
-    pub engines: &'static [Engine],
+    /// Why verify refuses the engines the mode's groups are not built for
+    /// ([`Mode::engines`]).
     pub other_engines_refused: &'static str,
     /// The colour models the mode's groups promise, and why the others are refused.
     pub color_models: &'static [ColorModel],
@@ -152,7 +153,6 @@ const GLASS_JUDGING: Judging = Judging {
     ring_tolerance_percent: 3.0,
 };
 
-const BOTH_ENGINES: &[Engine] = &[Engine::Cycles, Engine::Eevee];
 const BOTH_COLOR_MODELS: &[ColorModel] = &[ColorModel::Exact, ColorModel::Physical];
 /// The anisotropic and glass groups keep the colour exact (colour / E).
 const ONLY_EXACT: &[ColorModel] = &[ColorModel::Exact];
@@ -167,7 +167,6 @@ const ROUGHNESS: ModeSpec = ModeSpec {
     axis: SecondAxis::None,
     cycles: CYCLES,
     eevee: EEVEE,
-    engines: BOTH_ENGINES,
     other_engines_refused: "",
     color_models: BOTH_COLOR_MODELS,
     other_color_models_refused: "",
@@ -206,7 +205,6 @@ const LAYERED: ModeSpec = ModeSpec {
     mode: Mode::Layered,
     roughness: block_roughness,
     axis: SecondAxis::Ior(&IOR_SWEEP),
-    engines: &[Engine::Cycles],
     other_engines_refused: "the layered groups are calibrated for Cycles; in EEVEE's \
          furnace their rings miss 2 %, docs/EEVEE.md",
     uncorrected: "Mix Shader",
@@ -232,7 +230,6 @@ const ANISOTROPIC: ModeSpec = ModeSpec {
     mode: Mode::Anisotropic,
     roughness: block_roughness,
     axis: SecondAxis::Anisotropy(&ANISOTROPIC_SWEEP),
-    engines: &[Engine::Cycles],
     other_engines_refused: "EEVEE renders an anisotropic Glossy as an isotropic one, \
          docs/EEVEE.md",
     color_models: ONLY_EXACT,
@@ -254,7 +251,6 @@ const GLASS: ModeSpec = ModeSpec {
         judging: GLASS_JUDGING,
         ..EEVEE
     },
-    engines: &[Engine::Cycles],
     other_engines_refused: "the glass groups restore the energy of Cycles' Glass BSDF; \
          EEVEE renders glass its own way, docs/EEVEE.md",
     color_models: ONLY_EXACT,
@@ -306,7 +302,7 @@ mod tests {
                 SecondAxis::None => {}
                 SecondAxis::Ior(v) | SecondAxis::Anisotropy(v) => assert!(!v.is_empty(), "{key}"),
             }
-            assert!(!s.engines.is_empty(), "{key}: no engine");
+            assert!(!mode.engines().is_empty(), "{key}: no engine");
             for engine in [Engine::Cycles, Engine::Eevee] {
                 let d = s.defaults(engine);
                 assert!(d.samples > 0, "{key} in {}", engine.key());
@@ -321,7 +317,7 @@ mod tests {
                     engine.key()
                 );
             }
-            let refuses_an_engine = s.engines.len() < 2;
+            let refuses_an_engine = mode.engines().len() < 2;
             assert_eq!(
                 refuses_an_engine,
                 !s.other_engines_refused.is_empty(),
