@@ -286,10 +286,8 @@ fn group_spec(
     let normal = modes.iter().any(|m| m.per_pixel());
     let views = modes.iter().any(|m| m.reads_view_table());
     let layered = wants(Mode::Layered);
-    // Anisotropic GGX and Beckmann (Ashikhmin–Shirley's anisotropic lobe is another model).
-    let anisotropic = wants(Mode::Anisotropic) && d != Distribution::AshikhminShirley;
-    // Blender's Glass and Refraction BSDFs have GGX and Beckmann.
-    let glass = wants(Mode::Glass) && d != Distribution::AshikhminShirley;
+    let anisotropic = wants(Mode::Anisotropic) && Mode::Anisotropic.has_group_of(d);
+    let glass = wants(Mode::Glass) && Mode::Glass.has_group_of(d);
     let infix = engine_infix(engine);
     GroupSpec {
         distribution: d,

@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::measure::Engine;
+use crate::measure::{BlenderVersion, Distribution, Engine};
 
 /// Which correction a shader group applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -79,6 +79,20 @@ impl Mode {
             Some(_) => &[Engine::Cycles],
             None => &[Engine::Cycles, Engine::Eevee],
         }
+    }
+
+    /// Does this mode have a group of `d`? The anisotropic and glass groups are GGX and
+    /// Beckmann only: Ashikhmin–Shirley's anisotropic lobe is another model, and Blender's
+    /// Glass and Refraction BSDFs have no such distribution.
+    pub fn has_group_of(self, d: Distribution) -> bool {
+        !matches!(self, Mode::Anisotropic | Mode::Glass) || d != Distribution::AshikhminShirley
+    }
+
+    /// Does Blender `version` render this mode's group of `d` as its table describes? The
+    /// anisotropic Beckmann group from 3.5 on (Cycles 3.0–3.4 sample another lobe than they
+    /// evaluate). Glass's one exception, 3.5, is the whole mode's (`GlassTable`).
+    pub fn renders_group_of(self, d: Distribution, version: BlenderVersion) -> bool {
+        self.has_group_of(d) && (self != Mode::Anisotropic || version.renders_anisotropic(d))
     }
 
     /// Does this mode's group read the isotropic view table E(μ, r) (the anisotropic and

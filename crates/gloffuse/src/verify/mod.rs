@@ -385,10 +385,10 @@ fn check_roughness(roughness: &[Roughness]) -> Result<(), Error> {
     Ok(())
 }
 
-/// Anisotropic mode sweeps the distributions whose anisotropic group Blender `version`
-/// builds: GGX, and Beckmann from 3.5 (Cycles 3.0–3.4 sample another lobe than they
-/// evaluate); glass mode GGX and Beckmann, in every Blender but 3.5 (whose glass neither
-/// table describes). A distribution named outright that has none is an error.
+/// A sweep checks the distributions whose group of the mode Blender `version` renders
+/// ([`Mode::renders_group_of`]: anisotropic GGX, and Beckmann from 3.5; glass GGX and
+/// Beckmann), and glass mode none in 3.5 (whose glass neither table describes). A
+/// distribution named outright that has none is an error.
 fn with_groups(
     v: &VerifyOptions,
     distributions: Vec<Distribution>,
@@ -405,14 +405,7 @@ fn with_groups(
             ),
         ));
     }
-    if !matches!(v.mode, Mode::Anisotropic | Mode::Glass) {
-        return Ok(distributions);
-    }
-    // Past the refusal above, every glass distribution but Ashikhmin–Shirley has a group.
-    let has_group = |d: Distribution| {
-        d != Distribution::AshikhminShirley
-            && (v.mode == Mode::Glass || version.renders_anisotropic(d))
-    };
+    let has_group = |d: Distribution| v.mode.renders_group_of(d, version);
     if let Some(&d) = v.distributions.iter().find(|&&d| !has_group(d)) {
         return Err(Error::input(
             Field::Distribution,
