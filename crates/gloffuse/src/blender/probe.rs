@@ -356,7 +356,10 @@ fn run_probe(argv: &[OsString], deadline: Instant, cancel: &Cancel) -> Result<Ra
             written: Vec::new(),
         }),
         Exit::TimedOut => {
-            let within = format!("did not answer within {} s", format_seconds(timeout));
+            // To a tenth of a second: the milliseconds a loaded machine spends before the
+            // probe starts are not what the user set.
+            let shown = Duration::from_millis((timeout.as_millis() as u64 + 50) / 100 * 100);
+            let within = format!("did not answer within {} s", format_seconds(shown));
             let outcome = if timeout < PROBE_TIMEOUT {
                 Hint::text(within).then(Hint::new(" ({})", [Field::Timeout]))
             } else {
