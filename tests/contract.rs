@@ -7,29 +7,21 @@
 //!
 //! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
 use gloffuse::audit::job::{FixItem, document};
 use gloffuse::bench::audit::library_document;
-use gloffuse::fit::Coefficients;
-use gloffuse::generate::{ColorModel, Curves, GenerateParams, Mode};
-use gloffuse::measure::{Distribution, Engine, Masking, Roughness};
+use gloffuse::generate::Mode;
+use gloffuse::measure::{Distribution, Engine, Roughness};
 use gloffuse::verify::{Plan, RenderSettings};
-
-fn seed_params() -> GenerateParams {
-    let seed = Coefficients::load("seed").unwrap();
-    let curves = Curves::Pinned {
-        coefficients: &seed,
-        name: "seed",
-    };
-    GenerateParams::new(curves, &Masking::ALL, &[Mode::Roughness], ColorModel::Exact).unwrap()
-}
 
 #[test]
 fn the_python_validators_accept_the_real_documents_and_refuse_bad_ones() {
     let dir = tempfile::tempdir().unwrap();
-    let generate = seed_params();
+    let generate = common::seed_params();
     let render = RenderSettings::for_engine(Engine::Cycles);
     let plan = Plan::verify(
         &[Distribution::Ggx],

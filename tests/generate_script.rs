@@ -3,27 +3,18 @@
 //!
 //! Tier: fast (no Blender; `scripts/test.sh --fast` runs it).
 
-use gloffuse::fit::Coefficients;
+mod common;
+
 use gloffuse::generate::bundle::{bundle, bundle_from, concatenate};
-use gloffuse::generate::{ColorModel, Curves, GenerateParams, Job, Mode, assemble};
-use gloffuse::measure::Masking;
+use gloffuse::generate::{Job, assemble};
 use proptest::prelude::*;
 use std::path::Path;
 use std::process::Command;
 
-fn seed_params() -> GenerateParams {
-    let seed = Coefficients::load("seed").unwrap();
-    let curves = Curves::Pinned {
-        coefficients: &seed,
-        name: "seed",
-    };
-    GenerateParams::new(curves, &Masking::ALL, &[Mode::Roughness], ColorModel::Exact).unwrap()
-}
-
 /// Runs check_script.py on (script, expected parameters) pairs against a benign reference.
 fn check_scripts(dir: &Path, cases: &[(String, serde_json::Value)]) {
     let reference = dir.join("reference.py");
-    std::fs::write(&reference, assemble(&seed_params(), Job::Generate)).unwrap();
+    std::fs::write(&reference, assemble(&common::seed_params(), Job::Generate)).unwrap();
     let mut cmd = Command::new("python3");
     cmd.arg(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -102,7 +93,7 @@ fn the_bundler_makes_the_golden_bundle_of_the_fixture_package() {
 /// here; the script holds it on one line).
 #[test]
 fn the_seed_document_is_the_golden_one() {
-    let document = serde_json::to_string_pretty(&seed_params()).unwrap();
+    let document = serde_json::to_string_pretty(&common::seed_params()).unwrap();
     assert_golden("generate-seed.json", &format!("{document}\n"));
 }
 
@@ -110,9 +101,9 @@ fn the_seed_document_is_the_golden_one() {
 /// modules, and the call of its main; made twice, it is the same bytes.
 #[test]
 fn the_seed_script_is_byte_stable_and_holds_the_bundle() {
-    let script = assemble(&seed_params(), Job::Generate);
-    assert_eq!(script, assemble(&seed_params(), Job::Generate));
-    let document = serde_json::to_string(&seed_params()).unwrap();
+    let script = assemble(&common::seed_params(), Job::Generate);
+    assert_eq!(script, assemble(&common::seed_params(), Job::Generate));
+    let document = serde_json::to_string(&common::seed_params()).unwrap();
     let literal = serde_json::to_string(&document).unwrap();
     let header = script.split_once(&format!("GLOFFUSE_PARAMS = {literal}\n"));
     let (_, rest) = header.expect("the document's literal on its own line");
@@ -122,7 +113,7 @@ fn the_seed_script_is_byte_stable_and_holds_the_bundle() {
         .expect("the bundle after the header");
     assert!(main.ends_with("    main(GLOFFUSE_PARAMS)\n"), "{main}");
     let dir = tempfile::tempdir().unwrap();
-    let expect = serde_json::to_value(seed_params()).unwrap();
+    let expect = serde_json::to_value(common::seed_params()).unwrap();
     check_scripts(dir.path(), &[(script, expect)]);
 }
 
@@ -139,7 +130,7 @@ fn hostile_text_round_trips_and_never_becomes_code() {
     let cases: Vec<_> = nasty
         .iter()
         .map(|text| {
-            let mut p = seed_params();
+            let mut p = common::seed_params();
             for g in &mut p.groups {
                 for f in &mut g.families {
                     f.coefficients_source = text.to_string();
@@ -164,7 +155,7 @@ proptest! {
         let cases: Vec<_> = texts
             .chunks(2)
             .map(|pair| {
-                let mut p = seed_params();
+                let mut p = common::seed_params();
                 p.groups[0].families[0].coefficients_source = pair[0].clone();
                 p.groups[0].families[1].description = pair[1].clone();
                 p.groups[1].correction_group = pair[0].clone();

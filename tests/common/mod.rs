@@ -9,6 +9,19 @@ pub mod blender;
 pub mod oracle;
 pub mod user_file;
 
+/// The generate parameters of the `seed` preset in roughness mode, both masking families:
+/// the document the golden file and the contract's checks start from.
+pub fn seed_params() -> gloffuse::generate::GenerateParams {
+    use gloffuse::generate::{ColorModel, Curves, GenerateParams, Mode};
+    let seed = gloffuse::fit::Coefficients::load("seed").unwrap();
+    let curves = Curves::Pinned {
+        coefficients: &seed,
+        name: "seed",
+    };
+    let masking = &gloffuse::measure::Masking::ALL;
+    GenerateParams::new(curves, masking, &[Mode::Roughness], ColorModel::Exact).unwrap()
+}
+
 /// The `gloffuse` binary under test.
 pub fn gloffuse() -> assert_cmd::Command {
     assert_cmd::Command::cargo_bin("gloffuse").expect("the gloffuse binary is built")
