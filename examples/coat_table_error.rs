@@ -128,13 +128,7 @@ fn atlas_as_packed() {
     let mus: Vec<f64> = axis.iter().map(|m| m.get().max(1e-3)).collect();
     let z_max = slice_coordinate(IOR_MAX);
     for d in Distribution::ALL {
-        let grid = q.coat_grid(
-            d,
-            Masking::HeightCorrelated,
-            &axis,
-            &mus,
-            &gloffuse::progress::Quiet,
-        );
+        let grid = q.coat_grid(d, Masking::HeightCorrelated, &axis, &mus, &|| {});
         let lerp = |a: f64, b: f64, t: f64| a + t * (b - a);
         let sample = |k: usize, mu: f64, r: f64| {
             let (x, y) = (r * (ATLAS - 1) as f64, mu * (ATLAS - 1) as f64);

@@ -240,7 +240,7 @@ fn tables_are_identical_for_any_thread_count() {
                     Masking::HeightCorrelated,
                     &rs,
                     &mus,
-                    &gloffuse::progress::Quiet,
+                    &|| {},
                 )
             })
     };

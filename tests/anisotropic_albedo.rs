@@ -14,7 +14,6 @@ use gloffuse::measure::{
     AlbedoIntegrator, AnisotropicIntegrator, AnisotropicLobe, Distribution, Glossy, Masking,
     Roughness,
 };
-use gloffuse::progress::Quiet;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, LN_2};
 
@@ -134,8 +133,8 @@ fn the_grid_is_the_integrator_at_every_point() {
     let (d, m) = (Distribution::Ggx, Masking::HeightCorrelated);
     let axes = AnisotropicAxes::table(3, 4);
     assert!(axes.is_square());
-    let grid = q.grid(d, m, axes.clone(), &Quiet).unwrap();
-    let e_avg = q.average_grid(d, m, &axes.rx, &axes.ry, &Quiet).unwrap();
+    let grid = q.grid(d, m, axes.clone(), &|| {}).unwrap();
+    let e_avg = q.average_grid(d, m, &axes.rx, &axes.ry, &|| {}).unwrap();
     for (l, ry) in axes.ry.iter().enumerate() {
         for (j, rx) in axes.rx.iter().enumerate() {
             let lobe = lobe(d, m, rx * rx, ry * ry);
@@ -157,7 +156,7 @@ fn the_grid_is_the_integrator_at_every_point() {
     let mut wide = axes.clone();
     wide.ry = vec![0.5, 0.9];
     assert!(!wide.is_square());
-    let grid = q.grid(d, m, wide.clone(), &Quiet).unwrap();
+    let grid = q.grid(d, m, wide.clone(), &|| {}).unwrap();
     let direct = q.directional_albedo(&lobe(d, m, 1e-4, 0.81), view(wide.mu[1], wide.phi[1]));
     assert!((grid.e(1, 1, 0, 1) - direct).abs() < 1e-12);
 }

@@ -72,6 +72,56 @@ fn the_physics_crate_has_no_blender_io_or_cli_dependencies() {
     assert!(deps.contains("glam"), "the manifest was read: {deps:?}");
 }
 
+/// The standard library's ways out of a computation: the physics crate uses none of them.
+const NOT_NUMERICS: [&str; 6] = [
+    "std::fs",
+    "std::process",
+    "std::io",
+    "std::path",
+    "std::env",
+    "std::net",
+];
+
+/// Each `(file, word)` where a physics file's code names one of [`NOT_NUMERICS`].
+fn non_numeric_uses(files: &[(PathBuf, String)]) -> Vec<(PathBuf, &'static str)> {
+    let mut found = Vec::new();
+    for (file, text) in files {
+        for word in NOT_NUMERICS {
+            if text.lines().any(|line| code_of(line).contains(word)) {
+                found.push((file.clone(), word));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn the_physics_crate_touches_no_file_process_or_environment() {
+    let files: Vec<(PathBuf, String)> = rust_files(&root().join(PHYSICS).join("src"))
+        .into_iter()
+        .map(|f| {
+            let text = fs::read_to_string(&f).unwrap();
+            (f, text)
+        })
+        .collect();
+    assert!(files.len() > 10, "the physics sources were found");
+    let found = non_numeric_uses(&files);
+    assert!(
+        found.is_empty(),
+        "the physics crate is numerics only, its error included (files, processes and the \
+         environment belong to the library): {found:?}"
+    );
+    // The check sees a use where there is one, and not in a comment.
+    let planted = [(
+        PathBuf::from("error.rs"),
+        "// std::path in a comment\nuse std::path::PathBuf;\n".to_string(),
+    )];
+    assert_eq!(
+        non_numeric_uses(&planted),
+        [(PathBuf::from("error.rs"), "std::path")]
+    );
+}
+
 #[test]
 fn the_binary_depends_only_on_the_library_and_the_command_line_crates() {
     let deps = dependencies(&root().join("Cargo.toml"));

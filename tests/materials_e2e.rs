@@ -41,7 +41,6 @@ use gloffuse::measure::shading_normal::ReflectionRule;
 use gloffuse::measure::{
     AlbedoIntegrator, BlenderVersion, Distribution, Engine, Glossy, Masking, Roughness, coat,
 };
-use gloffuse::progress::Quiet;
 use gloffuse::verify::image::{Rgba, read_rgba};
 
 const SIZE: usize = 72;
@@ -241,7 +240,7 @@ struct Albedo {
 impl Albedo {
     fn new(d: Distribution, masking: Masking) -> Self {
         let integrator = AlbedoIntegrator::default();
-        let grid = integrator.grid(d, masking, &Roughness::grid(201), &[], &Quiet);
+        let grid = integrator.grid(d, masking, &Roughness::grid(201), &[], &|| {});
         Albedo {
             integrator,
             e_avg: grid.e_avg,

@@ -1,6 +1,6 @@
 //! gloffuse's physics: the BSDFs Blender evaluates and their albedo by quadrature
-//! ([`measure`]), the error type every gloffuse crate shares ([`error`]) and the way long
-//! work reports itself ([`progress`]).
+//! ([`measure`]) and the one error they raise for a value out of their range ([`error`],
+//! which the library wraps). Long work takes a `step` callback and calls it as it goes.
 //!
 //! This crate is numerics only: it runs no Blender, reads and writes no files and parses no
 //! command line (its dependencies are the numeric crates, serde and thiserror). The library
@@ -8,6 +8,5 @@
 
 pub mod error;
 pub mod measure;
-pub mod progress;
 
-pub use error::{Error, Field, Hint, Result};
+pub use error::{Error, Quantity, Result};

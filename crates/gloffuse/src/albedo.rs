@@ -143,13 +143,10 @@ fn table(
     let n = options.grid;
     let masking = options.blender_version.masking();
     let mus: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
-    let grid = AlbedoIntegrator::default().grid(
-        distribution,
-        masking,
-        &Roughness::grid(n),
-        &mus,
-        progress,
-    );
+    let grid =
+        AlbedoIntegrator::default().grid(distribution, masking, &Roughness::grid(n), &mus, &|| {
+            progress.step()
+        });
     write_output(&path, grid.csv().as_bytes())?;
     Ok(AlbedoOutput::Table {
         path,

@@ -10,7 +10,7 @@
 //! [`progress::Progress`], and errors name their input by a typed [`Field`]. See
 //! `docs/ARCHITECTURE.md`.
 
-pub use gloffuse_physics::{error, measure, progress};
+pub use gloffuse_physics::measure;
 
 pub mod albedo;
 pub mod audit;
@@ -19,12 +19,14 @@ pub mod blend_file;
 pub mod blender;
 #[cfg(test)]
 mod contract;
+pub mod error;
 pub mod file_lock;
 pub mod fit;
 pub mod generate;
 pub mod lut;
 pub mod output;
 pub mod plural;
+pub mod progress;
 pub mod refresh;
 pub mod report;
 pub mod shard;

@@ -186,11 +186,13 @@ pub(super) const BITS: &[Choice<Bits>] = &[
 ];
 
 pub(super) fn parse_distribution(s: &str) -> Result<Distribution, String> {
-    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+    s.parse()
+        .map_err(|e: gloffuse::measure::Error| e.to_string())
 }
 
 pub(super) fn parse_model(s: &str) -> Result<Model, String> {
-    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+    s.parse()
+        .map_err(|e: gloffuse::measure::Error| e.to_string())
 }
 
 pub(super) fn parse_ior(s: &str) -> Result<f64, String> {
@@ -204,11 +206,13 @@ pub(super) fn parse_ior(s: &str) -> Result<f64, String> {
 }
 
 pub(super) fn parse_roughness(s: &str) -> Result<Roughness, String> {
-    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+    s.parse()
+        .map_err(|e: gloffuse::measure::Error| e.to_string())
 }
 
 pub(super) fn parse_version(s: &str) -> Result<BlenderVersion, String> {
-    s.parse().map_err(|e: gloffuse::Error| e.to_string())
+    s.parse()
+        .map_err(|e: gloffuse::measure::Error| e.to_string())
 }
 
 pub(super) fn parse_point(s: &str) -> Result<Point, String> {

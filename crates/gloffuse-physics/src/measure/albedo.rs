@@ -15,7 +15,6 @@ use std::num::NonZeroUsize;
 
 use super::glossy::Glossy;
 use super::microfacet::{Distribution, Masking, Polar, Roughness};
-use crate::progress::Progress;
 
 /// Numbers of quadrature nodes; [`Quadrature::default`] meets the 2e-4 accuracy goal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -249,7 +248,7 @@ impl AlbedoIntegrator {
 
     /// `E(μ_i, r_j)` and `E_avg(r_j)` of one distribution and masking on a grid: the one
     /// table builder (the CSV, the packed view table, the LUTs and the fits all use it).
-    /// Columns (one per roughness) run in parallel and `progress` steps once per column;
+    /// Columns (one per roughness) run in parallel and `step` is called once per column;
     /// every entry is computed independently, so the table is identical for any thread
     /// count.
     pub fn grid(
@@ -258,7 +257,7 @@ impl AlbedoIntegrator {
         masking: Masking,
         roughness: &[Roughness],
         mu: &[f64],
-        progress: &dyn Progress,
+        step: &(dyn Fn() + Sync),
     ) -> AlbedoGrid {
         let columns: Vec<(Vec<f64>, f64)> = roughness
             .par_iter()
@@ -269,7 +268,7 @@ impl AlbedoIntegrator {
                     .map(|&mu| self.directional_albedo(&glossy, mu))
                     .collect();
                 let e_avg = self.average_albedo(&glossy);
-                progress.step();
+                step();
                 (e, e_avg)
             })
             .collect();

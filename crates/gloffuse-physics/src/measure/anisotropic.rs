@@ -24,8 +24,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use super::albedo::gauss_unit;
 use super::microfacet::{Distribution, Masking, Roughness};
-use crate::error::{Error, Field};
-use crate::progress::Progress;
+use crate::error::{Error, Quantity};
 
 /// The Glossy node's Anisotropy input as Cycles uses it: finite, clamped to [−0.99, 0.99].
 #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
@@ -41,7 +40,7 @@ impl Anisotropy {
             Ok(Anisotropy(value.clamp(-Self::MAX, Self::MAX)))
         } else {
             Err(Error::input(
-                Field::Anisotropy,
+                Quantity::Anisotropy,
                 value,
                 "a number from -1 to 1 (Cycles clamps it to ±0.99)",
             ))
@@ -76,7 +75,7 @@ impl AnisotropicLobe {
     ) -> Result<Self, Error> {
         if distribution == Distribution::AshikhminShirley {
             return Err(Error::input(
-                Field::Distribution,
+                Quantity::Distribution,
                 distribution.key(),
                 "ggx or beckmann (the anisotropic tables cover the two microfacet distributions)",
             ));
@@ -84,7 +83,7 @@ impl AnisotropicLobe {
         for alpha in [alpha_x, alpha_y] {
             if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
                 return Err(Error::input(
-                    Field::Roughness,
+                    Quantity::Roughness,
                     alpha,
                     "a lobe width α from 0 to 1 (Cycles clamps wider lobes to 1)",
                 ));
@@ -322,7 +321,7 @@ impl AnisotropicIntegrator {
     }
 
     /// `E(μ_i, φ_k, αx = rx_j², αy = ry_l²)` on a grid: the one table builder for the LUT
-    /// and the Blender groups. Slices of one `ry` run in parallel and `progress` steps once
+    /// and the Blender groups. Slices of one `ry` run in parallel and `step` is called once
     /// per slice; every entry is computed independently, so the table is identical for any
     /// thread count. On square axes (`rx` = `ry`, azimuths mirrored about π/4) half the
     /// entries come from the other half by [`swapped`]: turning the frame a quarter turn
@@ -332,7 +331,7 @@ impl AnisotropicIntegrator {
         distribution: Distribution,
         masking: Masking,
         axes: AnisotropicAxes,
-        progress: &dyn Progress,
+        step: &(dyn Fn() + Sync),
     ) -> Result<AnisotropicGrid, Error> {
         let lobes = lobe_rows(distribution, masking, &axes.rx, &axes.ry)?;
         let square = axes.is_square();
@@ -351,7 +350,7 @@ impl AnisotropicIntegrator {
                         );
                     }
                 }
-                progress.step();
+                step();
                 e
             })
             .collect();
@@ -380,21 +379,21 @@ impl AnisotropicIntegrator {
 
     /// `E_avg(rx_j², ry_l²)` per pair of widths, `[l · |rx| + j]`: the hemispherical average
     /// of [`Self::average_albedo`] (symmetric in the two widths). Rows of one `ry` run in
-    /// parallel and `progress` steps once per row.
+    /// parallel and `step` is called once per row.
     pub fn average_grid(
         &self,
         distribution: Distribution,
         masking: Masking,
         rx: &[f64],
         ry: &[f64],
-        progress: &dyn Progress,
+        step: &(dyn Fn() + Sync),
     ) -> Result<Vec<f64>, Error> {
         let lobes = lobe_rows(distribution, masking, rx, ry)?;
         let rows: Vec<Vec<f64>> = lobes
             .par_iter()
             .map(|row| {
                 let averages = row.iter().map(|lobe| self.average_albedo(lobe)).collect();
-                progress.step();
+                step();
                 averages
             })
             .collect();

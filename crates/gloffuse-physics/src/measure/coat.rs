@@ -17,7 +17,6 @@ use super::albedo::AlbedoIntegrator;
 use super::fresnel;
 use super::glossy::Glossy;
 use super::microfacet::{Distribution, Masking, Roughness};
-use crate::progress::Progress;
 
 /// Kulla and Conty's tint of the energy multiple bounces add, for a reflectance `f` (a
 /// colour channel, or a Fresnel average) and the white lobe's `E_avg`:
@@ -185,14 +184,14 @@ impl AlbedoIntegrator {
 
     /// The coat table (A, its gain, E) at the [`slice_iors`]: each (μ, r) entry takes one
     /// pass over the half vectors for every slice and E at once. Columns (one per roughness)
-    /// run in parallel; `progress` steps once per column.
+    /// run in parallel; `step` is called once per column.
     pub fn coat_grid(
         &self,
         distribution: Distribution,
         masking: Masking,
         roughness: &[Roughness],
         mu: &[f64],
-        progress: &dyn Progress,
+        step: &(dyn Fn() + Sync),
     ) -> CoatGrid {
         let ior = slice_iors();
         let f_avg = ior.map(fresnel_average);
@@ -222,7 +221,7 @@ impl AlbedoIntegrator {
                         }
                     })
                     .collect();
-                progress.step();
+                step();
                 column
             })
             .collect();
@@ -279,7 +278,7 @@ mod tests {
             Masking::HeightCorrelated,
             &rs,
             &[0.2, 0.8],
-            &crate::progress::Quiet,
+            &|| {},
         );
         assert_eq!(grid.ior[0], 1.0);
         assert!((grid.ior[SLICES - 1] - IOR_MAX).abs() < 1e-12);

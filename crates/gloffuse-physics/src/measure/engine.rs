@@ -9,7 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Distribution, Glossy, Masking, Roughness};
-use crate::error::{Error, Field};
+use crate::error::{Error, Quantity};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -83,6 +83,6 @@ impl std::str::FromStr for Engine {
         Engine::ALL
             .into_iter()
             .find(|e| e.key().eq_ignore_ascii_case(s))
-            .ok_or_else(|| Error::input(Field::Engine, s, "cycles or eevee"))
+            .ok_or_else(|| Error::input(Quantity::Engine, s, "cycles or eevee"))
     }
 }

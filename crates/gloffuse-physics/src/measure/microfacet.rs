@@ -10,7 +10,7 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use crate::error::{Error, Field};
+use crate::error::{Error, Quantity};
 
 /// The three single-scattering distributions of Blender's Glossy BSDF.
 #[derive(
@@ -98,7 +98,7 @@ impl std::str::FromStr for Distribution {
             .find(|d| d.key() == norm)
             .ok_or_else(|| {
                 Error::input(
-                    Field::Distribution,
+                    Quantity::Distribution,
                     s,
                     "one of beckmann, ggx, ashikhmin-shirley (case-insensitive; Blender's BECKMANN, GGX, ASHIKHMIN_SHIRLEY also work)",
                 )
@@ -157,7 +157,7 @@ impl Roughness {
             Ok(Roughness(value))
         } else {
             Err(Error::input(
-                Field::Roughness,
+                Quantity::Roughness,
                 value,
                 "a number from 0 to 1 (the Glossy node's Roughness range)",
             ))
@@ -199,7 +199,11 @@ impl std::str::FromStr for Roughness {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self, Error> {
         let v: f64 = s.trim().parse().map_err(|_| {
-            Error::input(Field::Roughness, s, "a number from 0 to 1, for example 0.5")
+            Error::input(
+                Quantity::Roughness,
+                s,
+                "a number from 0 to 1, for example 0.5",
+            )
         })?;
         Roughness::new(v)
     }

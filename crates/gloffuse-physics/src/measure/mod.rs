@@ -4,7 +4,8 @@
 //! the BSDF each render engine evaluates (`engine`), the normal a glossy BSDF shades with
 //! (`shading_normal`), the dielectric Fresnel (`fresnel`) and the coat of the layered shader
 //! (`coat`), the Glass and Refraction BSDFs and their albedo (`dielectric`; Cycles 3.0–3.4's
-//! Beckmann sampler reads `beckmann_table`), and the classic BRDF set (`brdf`).
+//! Beckmann sampler reads `beckmann_table`), and the classic BRDF set (`brdf`). A value out
+//! of their range is an [`Error`] naming its [`Quantity`].
 
 pub mod albedo;
 pub mod anisotropic;
@@ -19,6 +20,7 @@ pub mod microfacet;
 pub mod shading_normal;
 pub mod version;
 
+pub use crate::error::{Error, Quantity};
 pub use albedo::{AlbedoGrid, AlbedoIntegrator, Quadrature};
 pub use anisotropic::{AnisotropicIntegrator, AnisotropicLobe, Anisotropy};
 pub use dielectric::{

@@ -2,7 +2,7 @@
 //! of each version's Cycles.
 
 use super::microfacet::{Distribution, Masking};
-use crate::error::{Error, Field};
+use crate::error::{Error, Quantity};
 
 /// A Blender release, `major.minor` (a patch number is accepted and ignored).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -68,7 +68,7 @@ impl std::str::FromStr for BlenderVersion {
     fn from_str(s: &str) -> Result<Self, Error> {
         let bad = || {
             Error::input(
-                Field::BlenderVersion,
+                Quantity::BlenderVersion,
                 s,
                 "a version like 3.4, 4.5 or 5.0 (3.0 or later)",
             )
@@ -88,7 +88,7 @@ impl std::str::FromStr for BlenderVersion {
         let v = BlenderVersion { major, minor };
         if v < Self::OLDEST {
             return Err(Error::input(
-                Field::BlenderVersion,
+                Quantity::BlenderVersion,
                 s,
                 "Blender 3.0 or later (older Glossy BSDFs are not modelled)",
             ));

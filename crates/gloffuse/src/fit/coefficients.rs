@@ -11,7 +11,6 @@ use crate::measure::{
     AlbedoIntegrator, BlenderVersion, Distribution, Engine, Masking, Quadrature, Roughness,
 };
 use crate::output::write_output;
-use crate::progress::Quiet;
 
 pub const FORMAT: &str = "gloffuse-coefficients";
 pub const FORMAT_VERSION: u32 = 1;
@@ -394,7 +393,7 @@ impl Coefficients {
         };
         let points = Distribution::ALL.map(|d| {
             let (model, masking) = engine.model(d, version.masking());
-            let grid = integrator.grid(model, masking, &rs, mus, &Quiet);
+            let grid = integrator.grid(model, masking, &rs, mus, &|| {});
             let values = match target {
                 Target::Mean => grid.e_avg,
                 Target::Center => grid.e,

@@ -12,7 +12,6 @@ use crate::measure::{
     AlbedoIntegrator, AnisotropicIntegrator, BlenderVersion, DielectricIntegrator, DielectricNode,
     Distribution, GlassForm, Masking, Roughness, coat, grazing_crowded,
 };
-use crate::progress::Quiet;
 
 /// Side of the E(μ, r) table packed into the .blend for the view and multiscatter modes:
 /// bilinear interpolation of 96 × 96 samples stays within 0.33 % of E for μ ≥ 0.05
@@ -50,7 +49,7 @@ impl CoatTable {
         let integrator = AlbedoIntegrator::default();
         let axis = Roughness::grid(size);
         let mus: Vec<f64> = axis.iter().map(|mu| mu.get().max(1e-3)).collect();
-        let grid = integrator.coat_grid(distribution, masking, &axis, &mus, &Quiet);
+        let grid = integrator.coat_grid(distribution, masking, &axis, &mus, &|| {});
         let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
             let mut values = Vec::with_capacity(size * size * coat::SLICES);
             for i in 0..size {
@@ -101,7 +100,7 @@ impl AnisotropicTable {
                 distribution,
                 masking,
                 AnisotropicAxes::table(size, azimuths),
-                &Quiet,
+                &|| {},
             )
             .expect("the table's widths are within [0, 1] and its distribution GGX or Beckmann");
         let mut values = Vec::with_capacity(azimuths * size * size * size);
@@ -234,7 +233,7 @@ impl GlassTable {
             .map(|t| grazing_crowded(t.get()).max(1e-3))
             .collect();
         let integrator = DielectricIntegrator::default();
-        let grid = integrator.grid(distribution, from, &mus, &axis, &Quiet);
+        let grid = integrator.grid(distribution, from, &mus, &axis, &|| {});
         let packed = |at: &dyn Fn(usize, usize, usize) -> f64| {
             let mut values = Vec::with_capacity(size * size * coat::SLICES);
             for i in 0..size {
@@ -308,7 +307,7 @@ impl AlbedoTable {
             .iter()
             .map(|mu| mu.get().max(1e-3))
             .collect();
-        let grid = integrator.grid(distribution, masking, &Roughness::grid(size), &mus, &Quiet);
+        let grid = integrator.grid(distribution, masking, &Roughness::grid(size), &mus, &|| {});
         AlbedoTable {
             width: size,
             height: size,

@@ -97,10 +97,12 @@ pub fn anisotropic_table(
     let axes = AnisotropicAxes::table(size, AZIMUTHS);
     let integrator = AnisotropicIntegrator::default();
     let e_avg = integrator
-        .average_grid(distribution, masking, &axes.rx, &axes.ry, progress)
+        .average_grid(distribution, masking, &axes.rx, &axes.ry, &|| {
+            progress.step()
+        })
         .expect("grid points are widths within [0, 1] and the caller checked the distribution");
     let grid = integrator
-        .grid(distribution, masking, axes, progress)
+        .grid(distribution, masking, axes, &|| progress.step())
         .expect("grid points are widths within [0, 1] and the caller checked the distribution");
     let mut data = Vec::with_capacity(size * size * AZIMUTHS * size * 2);
     for l in 0..size {

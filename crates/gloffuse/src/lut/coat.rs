@@ -54,7 +54,8 @@ pub fn coat_table(
     let centres = Roughness::pixel_centres(size);
     let mus: Vec<f64> = centres.iter().map(|mu| mu.get()).collect();
     let grid =
-        AlbedoIntegrator::default().coat_grid(distribution, masking, &centres, &mus, progress);
+        AlbedoIntegrator::default()
+            .coat_grid(distribution, masking, &centres, &mus, &|| progress.step());
     let mut data = Vec::with_capacity(size * size * SLICES * 2);
     for y in 0..size {
         for k in 0..SLICES {

@@ -61,8 +61,8 @@ pub fn glass_table(
 ) -> Table {
     let centres = Roughness::pixel_centres(size);
     let mus: Vec<f64> = centres.iter().map(|mu| mu.get()).collect();
-    let grid =
-        DielectricIntegrator::default().grid(distribution, version, &mus, &centres, progress);
+    let grid = DielectricIntegrator::default()
+        .grid(distribution, version, &mus, &centres, &|| progress.step());
     let mut data = Vec::with_capacity(2 * size * size * SLICES * 2);
     for side in Side::BOTH {
         for y in 0..size {

@@ -241,7 +241,7 @@ fn albedo_grid(
 ) -> AlbedoGrid {
     let centres = Roughness::pixel_centres(size);
     let mus: Vec<f64> = centres.iter().map(|mu| mu.get()).collect();
-    AlbedoIntegrator::default().grid(distribution, masking, &centres, &mus, progress)
+    AlbedoIntegrator::default().grid(distribution, masking, &centres, &mus, &|| progress.step())
 }
 
 /// The albedo table: R = `E(μ_y, r_x)`, G = `E_avg(r_x)`; `progress` steps once per

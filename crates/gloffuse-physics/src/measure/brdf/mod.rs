@@ -23,7 +23,7 @@ pub use ward::Ward;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use crate::error::{Error, Field};
+use crate::error::{Error, Quantity};
 
 /// A reflection-only BRDF in the local shading frame, with a sampler and its pdf.
 pub trait Brdf {
@@ -148,7 +148,7 @@ impl std::str::FromStr for Model {
             .find(|m| m.key() == norm)
             .ok_or_else(|| {
                 Error::input(
-                    Field::Model,
+                    Quantity::Model,
                     s,
                     "one of lambert, phong, ward, cook-torrance, fresnel-blend (case-insensitive)",
                 )
@@ -203,7 +203,7 @@ impl Default for ModelParams {
 /// ```
 pub fn model_albedo(model: Model, params: &ModelParams, mu: f64) -> Result<f64, Error> {
     if !(mu > 0.0 && mu <= 1.0) {
-        return Err(Error::input(Field::ViewCosine, mu, "a number in (0, 1]"));
+        return Err(Error::input(Quantity::ViewCosine, mu, "a number in (0, 1]"));
     }
     Ok(model.brdf(params)?.albedo(mu, ALBEDO_GRID))
 }
@@ -226,7 +226,7 @@ fn reflectance(what: &'static str, value: f64) -> Result<f64, Error> {
         Ok(value)
     } else {
         Err(Error::input(
-            Field::ModelParameter(what),
+            Quantity::ModelParameter(what),
             value,
             "a number from 0 to 1",
         ))
@@ -239,7 +239,7 @@ fn width(what: &'static str, value: f64) -> Result<f64, Error> {
         Ok(value)
     } else {
         Err(Error::input(
-            Field::ModelParameter(what),
+            Quantity::ModelParameter(what),
             value,
             "a finite number > 0",
         ))

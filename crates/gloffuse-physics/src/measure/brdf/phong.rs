@@ -4,7 +4,7 @@ use glam::DVec3;
 use std::f64::consts::PI;
 
 use super::{Brdf, mirror, reflectance};
-use crate::error::{Error, Field};
+use crate::error::{Error, Quantity};
 
 /// `f = ρs (n + 2)/(2π) cosⁿα`, α the angle between ωi and the mirror direction of ωo,
 /// and 0 where cosα ≤ 0 (Lafortune & Willems 1994).
@@ -24,7 +24,7 @@ impl ModifiedPhong {
     pub fn new(rho_s: f64, n: f64) -> Result<Self, Error> {
         if !(n.is_finite() && n >= 0.0) {
             return Err(Error::input(
-                Field::ModelParameter("Phong exponent n"),
+                Quantity::ModelParameter("Phong exponent n"),
                 n,
                 "a finite number ≥ 0",
             ));

@@ -8,7 +8,6 @@ use super::integrator::DielectricIntegrator;
 use crate::measure::coat;
 use crate::measure::microfacet::{Distribution, Roughness};
 use crate::measure::version::BlenderVersion;
-use crate::progress::Progress;
 
 /// The view cosine below which light leaving a glass of index `ior` reflects totally at
 /// the normal: `√(1 − 1/IOR²)` (0 for an index of 1).
@@ -174,14 +173,14 @@ impl DielectricIntegrator {
     }
 
     /// The grid of `distribution` (GGX or Beckmann) as Blender `version` renders it, over
-    /// `mus` and `roughness`; rows of μ run in parallel and `progress` steps once per row.
+    /// `mus` and `roughness`; rows of μ run in parallel and `step` is called once per row.
     pub fn grid(
         &self,
         distribution: Distribution,
         version: BlenderVersion,
         mus: &[f64],
         roughness: &[Roughness],
-        progress: &dyn Progress,
+        step: &(dyn Fn() + Sync),
     ) -> DielectricGrid {
         let ior = coat::slice_iors();
         let (n, m) = (mus.len(), roughness.len());
@@ -210,7 +209,7 @@ impl DielectricIntegrator {
                         }
                     }
                 }
-                progress.step();
+                step();
                 (row, reflection)
             })
             .collect();
