@@ -624,3 +624,191 @@ fn sigterm_and_sighup_exit_128_plus_the_signal_and_write_nothing() {
         assert!(left.is_empty(), "signal {signal}: {left:?}");
     }
 }
+
+/// The text of one option in a `--help`, its lines joined by single spaces.
+fn option_help(help: &str, flag: &str) -> String {
+    let mut lines = help
+        .lines()
+        .skip_while(|l| !l.contains(&format!("{flag} ")));
+    let first = lines.next().unwrap_or_else(|| panic!("{flag} in the help"));
+    let rest = lines.take_while(|l| !l.trim_start().starts_with('-'));
+    std::iter::once(first)
+        .chain(rest)
+        .flat_map(str::split_whitespace)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The defaults `verify --help` spells out by hand are the ones each mode's spec holds: the
+/// samples and thresholds per engine (a mode named where it differs from roughness mode's),
+/// the roughness sweeps, the indices of refraction and the anisotropies.
+#[test]
+fn verify_help_spells_each_modes_defaults_as_its_spec_holds_them() {
+    use gloffuse::generate::Mode;
+    use gloffuse::measure::Engine;
+    use gloffuse::verify::modes::{EngineDefaults, SecondAxis, spec};
+
+    let out = gloffuse()
+        .args(["verify", "--help"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let help = String::from_utf8(out).unwrap();
+    type Value = fn(&EngineDefaults) -> String;
+    let numbers: [(&str, Value); 3] = [
+        ("--spp", |d| d.samples.to_string()),
+        ("--tolerance", |d| d.judging.tolerance_percent.to_string()),
+        ("--ring-tolerance", |d| {
+            d.judging.ring_tolerance_percent.to_string()
+        }),
+    ];
+    let base = spec(Mode::Roughness);
+    for (flag, value) in numbers {
+        let text = option_help(&help, flag);
+        let cycles = format!("Cycles {}", value(&base.cycles));
+        let eevee = format!("EEVEE {}", value(&base.eevee));
+        assert!(text.contains(&cycles), "{flag}: {cycles:?} in {text:?}");
+        assert!(text.contains(&eevee), "{flag}: {eevee:?} in {text:?}");
+        for mode in Mode::ALL {
+            let own = value(&spec(mode).cycles);
+            let named = format!("{} mode {own}", mode.key());
+            if own == value(&base.cycles) {
+                let mode_number = format!("{} mode ", mode.key());
+                let numbered = text
+                    .match_indices(&mode_number)
+                    .any(|(i, m)| text[i + m.len()..].starts_with(|c: char| c.is_ascii_digit()));
+                assert!(
+                    !numbered,
+                    "{flag}: no own value for {} mode in {text:?}",
+                    mode.key()
+                );
+            } else {
+                assert!(text.contains(&named), "{flag}: {named:?} in {text:?}");
+            }
+            if mode.engines().contains(&Engine::Eevee) {
+                assert_eq!(
+                    value(&spec(mode).eevee),
+                    value(&base.eevee),
+                    "{flag}: the help gives one EEVEE value, so {} mode has it too",
+                    mode.key()
+                );
+            }
+        }
+    }
+
+    let list = |values: Vec<String>, sep: &str| values.join(sep);
+    let sweep = |mode: Mode| {
+        (spec(mode).roughness)()
+            .iter()
+            .map(|r| r.get().to_string())
+            .collect::<Vec<_>>()
+    };
+    let text = option_help(&help, "--roughness");
+    let even: Vec<String> = (0..=10)
+        .map(|i| (f64::from(i) / 10.0).to_string())
+        .collect();
+    assert_eq!(
+        sweep(Mode::Roughness),
+        even,
+        "roughness mode sweeps 0, 0.1, …, 1"
+    );
+    assert!(text.contains("[default: 0, 0.1, …, 1;"), "{text:?}");
+    let blocks: Vec<Mode> = Mode::ALL
+        .into_iter()
+        .filter(|&m| sweep(m) != even)
+        .collect();
+    assert_eq!(blocks, [Mode::Layered, Mode::Anisotropic, Mode::Glass]);
+    for mode in &blocks {
+        assert_eq!(sweep(*mode), sweep(blocks[0]));
+    }
+    let named = format!(
+        "layered, anisotropic and glass mode: {}]",
+        list(sweep(Mode::Layered), ", ")
+    );
+    assert!(text.contains(&named), "{named:?} in {text:?}");
+
+    for (flag, mode) in [
+        ("--ior", Mode::Glass),
+        ("--ior", Mode::Layered),
+        ("--anisotropy", Mode::Anisotropic),
+    ] {
+        let values = match spec(mode).axis {
+            SecondAxis::Ior(v) | SecondAxis::Anisotropy(v) => v,
+            SecondAxis::None => panic!("{} mode has a second axis", mode.key()),
+        };
+        let default = format!(
+            "[default: {}]",
+            list(values.iter().map(f64::to_string).collect(), ",")
+        );
+        let text = option_help(&help, flag);
+        assert!(text.contains(&default), "{flag}: {default:?} in {text:?}");
+    }
+}
+
+fn help_of(command: &[&str]) -> String {
+    let out = gloffuse()
+        .args(command)
+        .arg("--help")
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    String::from_utf8(out).unwrap()
+}
+
+/// The other defaults a `--help` spells by hand: each table kind's size and size range, the
+/// measurement's samples per engine, and the verdicts that fail an audit.
+#[test]
+fn lut_refresh_and_audit_help_spell_the_librarys_defaults() {
+    use gloffuse::audit::AuditJudging;
+    use gloffuse::lut::Kind;
+    use gloffuse::measure::Engine;
+    use gloffuse::refresh::measure_samples;
+
+    let size = option_help(&help_of(&["lut"]), "--size");
+    let kinds = [
+        Kind::SplitSum,
+        Kind::KullaConty,
+        Kind::Albedo,
+        Kind::Coat,
+        Kind::Anisotropic,
+        Kind::Glass,
+    ];
+    let most = Kind::Albedo.facts().default_size;
+    for kind in kinds {
+        let facts = kind.facts();
+        if facts.default_size != most {
+            let named = format!("{} for {}", facts.default_size, facts.key);
+            assert!(size.contains(&named), "{named:?} in {size:?}");
+        }
+        if let Some(limit) = &facts.size_limit {
+            let range = if limit.min == 1 {
+                format!("{} {}", facts.key, limit.max)
+            } else {
+                format!("{} {} to {}", facts.key, limit.min, limit.max)
+            };
+            assert!(size.contains(&range), "{range:?} in {size:?}");
+        }
+    }
+    assert!(size.contains(&format!("{most} otherwise]")), "{size:?}");
+
+    let spp = option_help(&help_of(&["refresh"]), "--spp");
+    let named = format!(
+        "[default: Cycles {}, EEVEE {}]",
+        measure_samples(Engine::Cycles),
+        measure_samples(Engine::Eevee)
+    );
+    assert!(spp.contains(&named), "{named:?} in {spp:?}");
+
+    let fail_on = option_help(&help_of(&["audit"]), "--fail-on");
+    let keys: Vec<&str> = AuditJudging::default()
+        .fail_on
+        .iter()
+        .map(|v| v.key())
+        .collect();
+    let named = format!("[default: {}]", keys.join(","));
+    assert!(fail_on.contains(&named), "{named:?} in {fail_on:?}");
+}
