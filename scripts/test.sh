@@ -169,12 +169,13 @@ lint() {
 
 # `cargo test ARGS` with $GLOFFUSE_TEST_SKIPS naming a fresh file, into which every test
 # skipped for a missing install (allowed only by a GLOFFUSE_SKIP_*_TESTS=1 variable) writes
-# one line, then the list of them: cargo counts a skipped test as passed. cargo's exit
+# one line, then the list of them: cargo counts a skipped test as passed. Every test file
+# runs even after one fails (--no-fail-fast), so a failure hides no other; cargo's exit
 # status is returned unchanged.
 cargo_test() {
     local skips status=0
     skips="$(mktemp "${TMPDIR:-/tmp}/gloffuse-skips.XXXXXX")"
-    GLOFFUSE_TEST_SKIPS="$skips" cargo test "$@" || status=$?
+    GLOFFUSE_TEST_SKIPS="$skips" cargo test --no-fail-fast "$@" || status=$?
     skip_summary "$skips"
     rm -f "$skips"
     return "$status"

@@ -124,10 +124,11 @@ fn bpy_4_5_is_shared_with_gloffuse_not_downloaded_twice() {
     assert_eq!(std::fs::read_link(&test).unwrap(), venv);
 }
 
-/// `cargo_test` hands cargo a fresh `$GLOFFUSE_TEST_SKIPS` file, lists what the tests wrote
-/// into it after cargo's own summary (which counts a skip as `ok`), removes it, and returns
-/// cargo's exit status unchanged; with no skips it adds nothing. (A stand-in `cargo` writes
-/// the lines `common::skip` writes.)
+/// `cargo_test` runs every test file even after a failure (`--no-fail-fast`), hands cargo a
+/// fresh `$GLOFFUSE_TEST_SKIPS` file, lists what the tests wrote into it after cargo's own
+/// summary (which counts a skip as `ok`), removes it, and returns cargo's exit status
+/// unchanged; with no skips it adds nothing. (A stand-in `cargo` writes the lines
+/// `common::skip` writes.)
 #[test]
 fn the_summary_lists_the_skipped_tests_and_keeps_cargos_status() {
     let tmp = tempfile::tempdir().unwrap();
@@ -143,7 +144,7 @@ fn the_summary_lists_the_skipped_tests_and_keeps_cargos_status() {
     let stdout = text(&out.stdout);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(
-        stdout.contains("ARGS test --locked --test verify_e2e\n"),
+        stdout.contains("ARGS test --no-fail-fast --locked --test verify_e2e\n"),
         "{stdout}"
     );
     let summary = stdout
