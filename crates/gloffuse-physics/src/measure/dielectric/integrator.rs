@@ -4,8 +4,8 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
+use super::axes::{critical_cosine, grazing_crowded, grazing_crowded_coordinate};
 use super::bsdf::{Dielectric, DielectricNode, GlassForm, Sampler};
-use super::grid::{critical_cosine, grazing_crowded, grazing_crowded_coordinate};
 use crate::measure::albedo::gauss_unit;
 use crate::measure::beckmann_table::{self, SlopeTable};
 use crate::measure::fresnel;

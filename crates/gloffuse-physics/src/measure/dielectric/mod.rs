@@ -29,16 +29,18 @@
 //! light sampling reaches; the sampler, and Cycles' own `ggx_glass_E` tables, do not.
 //!
 //! The BSDF itself is in `bsdf` (the node, its form and sampler per version, one sample's
-//! weight), its albedo in `integrator`, and the view-cosine axes and table builder of the
-//! glass tables in `grid`.
+//! weight), its albedo in `integrator`, the glass tables' view-cosine axes in `axes` and
+//! their builder in `grid`.
 
+mod axes;
 mod bsdf;
 mod grid;
 mod integrator;
 
-pub use bsdf::{Dielectric, DielectricNode, GlassForm, Sampler};
-pub use grid::{
-    DielectricGrid, Side, critical_cosine, critical_crowded, critical_crowded_coordinate,
-    grazing_crowded, grazing_crowded_coordinate,
+pub use axes::{
+    critical_cosine, critical_crowded, critical_crowded_coordinate, grazing_crowded,
+    grazing_crowded_coordinate,
 };
+pub use bsdf::{Dielectric, DielectricNode, GlassForm, Sampler};
+pub use grid::{DielectricGrid, Side};
 pub use integrator::{DielectricIntegrator, DielectricQuadrature};
