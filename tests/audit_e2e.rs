@@ -68,10 +68,13 @@ fn check_against_oracle(label: &str, report: &Value, expected: &Expected, root: 
             "{what}: {}",
             want.reason
         );
+        // The PBR range rules judge colours, which this library chooses for the furnace
+        // (white, mostly): tests/audit_pbr.rs is their oracle, so they are left out here.
         let found: BTreeSet<(String, Vec<String>)> = m["findings"]
             .as_array()
             .unwrap()
             .iter()
+            .filter(|f| !f["rule"].as_str().unwrap().starts_with("pbr-"))
             .map(|f| {
                 let path = f["node_path"].as_array().unwrap();
                 let path = path
