@@ -91,26 +91,92 @@ fn cases() -> Vec<Value> {
         // Substance's dark floor, 30 strict and 50 recommended, per channel.
         case("non-metal 29", "principled", grey(29.0), 0.0, "socket"),
         case("non-metal 31", "principled", grey(31.0), 0.0, "socket"),
-        case("blue channel 49", "principled", [120.0, 120.0, 49.0], 0.0, "socket"),
-        case("blue channel 51", "principled", [120.0, 120.0, 51.0], 0.0, "socket"),
+        case(
+            "blue channel 49",
+            "principled",
+            [120.0, 120.0, 49.0],
+            0.0,
+            "socket",
+        ),
+        case(
+            "blue channel 51",
+            "principled",
+            [120.0, 120.0, 51.0],
+            0.0,
+            "socket",
+        ),
         case("pure red", "diffuse", [255.0, 0.0, 0.0], 0.0, "socket"),
         // Unity's metal floor, 186, by luminance.
         case("metal 185", "principled", grey(185.0), 1.0, "socket"),
         case("metal 187", "principled", grey(187.0), 1.0, "socket"),
         // Substance's metal reflectance, 60 % (153 sRGB), per channel.
-        case("metal blue 152", "principled", [230.0, 230.0, 152.0], 1.0, "socket"),
-        case("metal blue 154", "principled", [230.0, 230.0, 154.0], 1.0, "socket"),
+        case(
+            "metal blue 152",
+            "principled",
+            [230.0, 230.0, 152.0],
+            1.0,
+            "socket",
+        ),
+        case(
+            "metal blue 154",
+            "principled",
+            [230.0, 230.0, 154.0],
+            1.0,
+            "socket",
+        ),
         // What counts as a metal: Metallic 0.9 and above; a non-metal: 0.1 and below.
-        case("metallic 0.9 at 185", "principled", grey(185.0), 0.9, "socket"),
-        case("metallic 0.1 at 49", "principled", grey(49.0), 0.1, "socket"),
-        case("metallic 0.5 at 10", "principled", grey(10.0), 0.5, "socket"),
-        case("metallic 0.85 at 10", "principled", grey(10.0), 0.85, "socket"),
+        case(
+            "metallic 0.9 at 185",
+            "principled",
+            grey(185.0),
+            0.9,
+            "socket",
+        ),
+        case(
+            "metallic 0.1 at 49",
+            "principled",
+            grey(49.0),
+            0.1,
+            "socket",
+        ),
+        case(
+            "metallic 0.5 at 10",
+            "principled",
+            grey(10.0),
+            0.5,
+            "socket",
+        ),
+        case(
+            "metallic 0.85 at 10",
+            "principled",
+            grey(10.0),
+            0.85,
+            "socket",
+        ),
         // Diffuse is a non-metal, Glossy a metal's reflectance.
         case("diffuse 49", "diffuse", grey(49.0), 0.0, "socket"),
-        case("diffuse 244 by RGB node", "diffuse", grey(244.0), 0.0, "rgb"),
-        case("diffuse 10 by texture", "diffuse", grey(10.0), 0.0, "texture"),
+        case(
+            "diffuse 244 by RGB node",
+            "diffuse",
+            grey(244.0),
+            0.0,
+            "rgb",
+        ),
+        case(
+            "diffuse 10 by texture",
+            "diffuse",
+            grey(10.0),
+            0.0,
+            "texture",
+        ),
         case("glossy 185", "glossy", grey(185.0), 0.0, "socket"),
-        case("glossy blue 152 by RGB node", "glossy", [255.0, 255.0, 152.0], 0.0, "rgb"),
+        case(
+            "glossy blue 152 by RGB node",
+            "glossy",
+            [255.0, 255.0, 152.0],
+            0.0,
+            "rgb",
+        ),
         case("glossy white", "glossy", grey(255.0), 0.0, "socket"),
         // Gold (linear 1.0, 0.766, 0.336) is a plausible metal.
         json!({"name": "gold", "node": "principled", "color": [1.0, 0.766, 0.336],
@@ -129,7 +195,11 @@ fn pbr_rules_fire_exactly_at_their_bounds(label: &'static str, blender: PathBuf)
     let cases = cases();
     std::fs::write(&cases_path, serde_json::to_string(&cases).unwrap()).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/pbr_cases.py");
-    let made = run_in_blender(&blender, &script, &[cases_path.as_os_str(), file.as_os_str()]);
+    let made = run_in_blender(
+        &blender,
+        &script,
+        &[cases_path.as_os_str(), file.as_os_str()],
+    );
     assert!(
         made.status.success() && file.is_file(),
         "Blender {label}: {}",
@@ -147,9 +217,16 @@ fn pbr_rules_fire_exactly_at_their_bounds(label: &'static str, blender: PathBuf)
             if !rule.starts_with("pbr-") {
                 continue;
             }
-            let strict = if f["detail"]["strict"] == true { " strict" } else { "" };
+            let strict = if f["detail"]["strict"] == true {
+                " strict"
+            } else {
+                ""
+            };
             rules.insert(format!("{rule}{strict}"));
-            assert_eq!(f["node"], format!("{} ▸ Shader", m["material"].as_str().unwrap()));
+            assert_eq!(
+                f["node"],
+                format!("{} ▸ Shader", m["material"].as_str().unwrap())
+            );
         }
     }
     let mut firing = 0;
@@ -182,7 +259,8 @@ fn pbr_rules_fire_exactly_at_their_bounds(label: &'static str, blender: PathBuf)
         .unwrap();
     let why = dark["why"].as_str().unwrap();
     assert!(
-        why.contains("Substance") && why.contains("Base Color sRGB 29.0, 29.0, 29.0")
+        why.contains("Substance")
+            && why.contains("Base Color sRGB 29.0, 29.0, 29.0")
             && why.contains("strict floor (30)"),
         "{why}"
     );
