@@ -15,6 +15,7 @@
 #   twin_groups(audit) -> the gloffuse group names a twin may use
 #   scan_material(material, rules, groups) -> ([finding, ...], error or None)
 #   scan_scenes(rules) -> file findings (filter-glossy)
+#   srgb_255(linear), luminance_255(color) -> the PBR rules' sRGB values
 #   uv_maps_named(material) -> the UV map names its nodes name
 # ---------------------------------------------------------------------------
 import math
@@ -463,6 +464,113 @@ def rule_depends_on_scene(node, groups):
     return [finding("depends-on-scene", node, detail)]
 
 
+# --- PBR ranges (issue 41): plausible albedos, read off constant colours ----------
+# Socket colours are scene-linear; the charts the rules cite are in 8-bit sRGB.
+# Unity's Material Validator compares the luminance (Rec. 709 weights on the
+# linear colour, then encoded); Substance's PBR Validate compares each channel.
+# Bounds are 0..255 sRGB values, not rounded: a value at a bound passes.
+UNITY_NON_METAL = (50.0, 243.0)
+UNITY_METAL_FLOOR = 186.0
+SUBSTANCE_DARK_STRICT = 30.0
+SUBSTANCE_DARK_RECOMMENDED = 50.0
+SUBSTANCE_METAL_FLOOR = 0.6 * 255.0  # 60 % reflectance, as a share of the sRGB value
+METAL_FROM = 0.9  # Metallic at or above: a metal
+NON_METAL_UP_TO = 0.1  # Metallic at or below: a non-metal; in between: neither
+
+
+def srgb_255(linear):
+    """A linear channel as an sRGB value in 0..255 (the standard transfer function
+    with its linear segment below 0.0031308); not rounded."""
+    c = max(float(linear), 0.0)
+    encoded = 12.92 * c if c <= 0.0031308 else 1.055 * c ** (1.0 / 2.4) - 0.055
+    return 255.0 * encoded
+
+
+def luminance_255(color):
+    """The colour's luminance (Rec. 709 weights on the linear channels) in sRGB 0..255."""
+    return srgb_255(0.2126729 * color[0] + 0.7151522 * color[1] + 0.0721750 * color[2])
+
+
+def constant_color(socket):
+    """The socket's colour when it is constant: its own value, or an RGB node's
+    (through Reroutes and muted nodes); None when anything else feeds it."""
+    out = source(socket)
+    if out is None:
+        return constant(socket)
+    if out.node.bl_idname == "ShaderNodeRGB":
+        return [round(float(c), 6) for c in out.default_value[:3]]
+    return None
+
+
+def pbr_colors(node):
+    """(input name, linear colour, "metal" or "non-metal", Metallic) of each colour
+    of `node` the PBR rules judge: a Principled BSDF's Base Color by its constant
+    Metallic (none while Transmission is not constant 0: a glass's colour is its
+    tint), a Diffuse BSDF's Color (a non-metal), a Glossy BSDF's Color (a metal's
+    reflectance)."""
+    idname = node.bl_idname
+    if idname == "ShaderNodeBsdfDiffuse":
+        found = [("Color", "non-metal", None)]
+    elif idname in GLOSSY_TYPES:
+        found = [("Color", "metal", None)]
+    elif idname == "ShaderNodeBsdfPrincipled":
+        transmission = principled_input(node, "transmission")
+        metallic = constant(node.inputs["Metallic"])
+        if (transmission is not None and constant(transmission) != 0.0) or metallic is None:
+            return []
+        kind = "metal" if metallic >= METAL_FROM else "non-metal" if metallic <= NON_METAL_UP_TO else None
+        found = [("Base Color", kind, metallic)] if kind else []
+    else:
+        return []
+    colors = []
+    for name, kind, metallic in found:
+        color = constant_color(node.inputs[name])
+        if color is not None:
+            colors.append((name, color, kind, metallic))
+    return colors
+
+
+def pbr_detail(name, color, kind, metallic):
+    detail = {"input": name, "color": color, "kind": kind,
+              "srgb": [round(srgb_255(c), 2) for c in color], "luminance": round(luminance_255(color), 2)}
+    if metallic is not None:
+        detail["metallic"] = metallic
+    return detail
+
+
+def rule_pbr_albedo_range(node, groups):
+    """Unity's charts: a non-metal's luminance within 50..243 sRGB, a metal's at least 186."""
+    found = []
+    for name, color, kind, metallic in pbr_colors(node):
+        lum = luminance_255(color)
+        low, high = UNITY_NON_METAL if kind == "non-metal" else (UNITY_METAL_FLOOR, math.inf)
+        if lum < low or lum > high:
+            found.append(finding("pbr-albedo-range", node, pbr_detail(name, color, kind, metallic)))
+    return found
+
+
+def rule_pbr_dark_albedo(node, groups):
+    """Substance's dark floor: each channel of a non-metal's colour at least 50 sRGB
+    (recommended), 30 (strict; `strict` in the detail when below it)."""
+    found = []
+    for name, color, kind, metallic in pbr_colors(node):
+        darkest = min(srgb_255(c) for c in color)
+        if kind == "non-metal" and darkest < SUBSTANCE_DARK_RECOMMENDED:
+            detail = pbr_detail(name, color, kind, metallic)
+            detail["strict"] = darkest < SUBSTANCE_DARK_STRICT
+            found.append(finding("pbr-dark-albedo", node, detail))
+    return found
+
+
+def rule_pbr_metal_reflectance(node, groups):
+    """Substance's metal reflectance: each channel of a metal's colour at least 60 %."""
+    found = []
+    for name, color, kind, metallic in pbr_colors(node):
+        if kind == "metal" and min(srgb_255(c) for c in color) < SUBSTANCE_METAL_FLOOR:
+            found.append(finding("pbr-metal-reflectance", node, pbr_detail(name, color, kind, metallic)))
+    return found
+
+
 UV_MAP_NODES = (("ShaderNodeUVMap", "uv_map"), ("ShaderNodeNormalMap", "uv_map"),
                 ("ShaderNodeTangent", "uv_map"))
 
@@ -511,6 +619,9 @@ NODE_RULES = (
     rule_holdout,
     rule_depends_on_scene,
     rule_unknown_node,
+    rule_pbr_albedo_range,
+    rule_pbr_dark_albedo,
+    rule_pbr_metal_reflectance,
 )
 
 

@@ -98,6 +98,9 @@ pub fn word(f: &JobFinding, predictor: &mut Predictor) -> Finding {
     if let Some(said) = f.detail["blender_said"].as_str() {
         why = format!("{why} (Blender said “{said}”)");
     }
+    if let Some(read) = pbr_values(&f.detail) {
+        why = format!("{why}: {read}");
+    }
     if let Some(p) = predicted {
         why.push_str(&format!(
             "; the integrator predicts {:.1} % for this lobe",
@@ -117,6 +120,29 @@ pub fn word(f: &JobFinding, predictor: &mut Predictor) -> Finding {
         twin: f.twin.clone(),
         detail: f.detail.clone(),
     }
+}
+
+/// What a PBR range rule read off the node, in the charts' sRGB units: "Base Color sRGB
+/// 29.0, 29.0, 29.0 (luminance 29.0), Metallic 0, below the strict floor (30)".
+fn pbr_values(detail: &serde_json::Value) -> Option<String> {
+    let srgb: Vec<String> = detail["srgb"]
+        .as_array()?
+        .iter()
+        .map(|c| format!("{:.1}", c.as_f64().unwrap_or(f64::NAN)))
+        .collect();
+    let mut words = format!(
+        "{} sRGB {} (luminance {:.1})",
+        detail["input"].as_str().unwrap_or("colour"),
+        srgb.join(", "),
+        detail["luminance"].as_f64().unwrap_or(f64::NAN)
+    );
+    if let Some(m) = detail["metallic"].as_f64() {
+        words.push_str(&format!(", Metallic {m}"));
+    }
+    if detail["strict"] == true {
+        words.push_str(", below the strict floor (30)");
+    }
+    Some(words)
 }
 
 fn pct(x: f64) -> String {

@@ -243,6 +243,45 @@ pub const RULES: &[Rule] = &[
               tree): its light is measured by the furnace only",
         fix: "check the node by hand",
     },
+    // The PBR range rules (issue 41): plausible albedos, read off constant colours (an
+    // unlinked socket or an RGB node) in sRGB, without a render. Metal: a Principled BSDF
+    // with Metallic at or above 0.9, or a Glossy BSDF's colour; non-metal: Metallic at or
+    // below 0.1, or a Diffuse BSDF's colour (docs/AUDIT.md, "PBR ranges"). Intended severities, for
+    // the per-rule severities to come: pbr-albedo-range info, pbr-dark-albedo and
+    // pbr-metal-reflectance warning.
+    Rule {
+        id: "pbr-albedo-range",
+        // Intended severity: info.
+        effect: Effect::Info,
+        from: v(3, 0),
+        before: None,
+        why: "the colour's luminance is outside the range of Unity's Material Validator \
+              (Unity's material charts: 50–243 sRGB for non-metals, 186–255 for metals)",
+        fix: "bring the colour's luminance into the range, unless the material is meant to be \
+              that dark or bright",
+    },
+    Rule {
+        id: "pbr-dark-albedo",
+        // Intended severity: warning.
+        effect: Effect::Info,
+        from: v(3, 0),
+        before: None,
+        why: "a channel of the non-metal's colour is below the dark floor of Substance's PBR \
+              Validate: 50 sRGB recommended, 30 strict (no real surface is darker than \
+              charcoal, about 4 % reflectance)",
+        fix: "raise every channel of the colour to 50 sRGB or more (30 at the very least)",
+    },
+    Rule {
+        id: "pbr-metal-reflectance",
+        // Intended severity: warning.
+        effect: Effect::Info,
+        from: v(3, 0),
+        before: None,
+        why: "a channel of the metal's colour is below the 60–100 % metal reflectance of \
+              Substance's PBR Validate (60 % of 255 sRGB: 153)",
+        fix: "raise every channel of the metal's colour to 60 % (153 sRGB) or more, or make \
+              the material a non-metal",
+    },
 ];
 
 /// The rule `id`, if the catalogue has it.
