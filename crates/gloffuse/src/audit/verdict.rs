@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::fix_choice::MaterialFix;
-use super::rules::Effect;
+use super::rules::{Effect, Severity};
 use crate::shard::Shard;
 
 /// What the furnace and the rules say about one material.
@@ -78,6 +78,28 @@ pub struct Finding {
     pub twin: Option<String>,
     /// What the job read off the node (distribution, roughness, …).
     pub detail: serde_json::Value,
+    /// How much it counts: only an `error` finding fails the check (the catalogue's
+    /// default, or the configuration's `[severity]`).
+    #[serde(default)]
+    pub severity: Severity,
+    /// The waiver that suppresses it, if any: it stays in the report and fails nothing.
+    #[serde(default)]
+    pub waived: Option<Waived>,
+}
+
+/// Why a finding, or a material's verdict, is suppressed: the waiver's reason and where it
+/// came from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Waived {
+    pub reason: String,
+    /// `material` or `node` (its `gloffuse_ignore` property), or `config` (a gloffuse.toml).
+    pub from: String,
+    /// The material or node (`A ▸ B`) that carries the property, or the configuration file.
+    #[serde(rename = "where")]
+    pub place: String,
+    /// The configuration's line where the `[[waiver]]` entry starts.
+    #[serde(default)]
+    pub line: Option<usize>,
 }
 
 /// Furnace brightness of one sphere (1.0 = 100 %), as the furnace shows it: where the
@@ -104,6 +126,9 @@ pub struct After {
     pub verdict: Verdict,
     pub mean: Option<f64>,
     pub findings: usize,
+    /// Whether it fails the check after the fix (what the exit code of a fix counts).
+    #[serde(default)]
+    pub fails: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -113,6 +138,13 @@ pub struct AuditedMaterial {
     pub verdict: Verdict,
     /// Why, in words.
     pub reason: String,
+    /// Whether it fails the check: its verdict is in `fail_on` and rests on a finding that
+    /// counts (or on none, unwaived), or an `info` rule's finding raised to `error` counts.
+    #[serde(default)]
+    pub fails: bool,
+    /// Why a verdict in `fail_on` does not fail: its findings waived or below `error`.
+    #[serde(default)]
+    pub suppressed: Option<String>,
     pub mean: Option<f64>,
     pub center: Option<f64>,
     pub rim: Option<f64>,
@@ -181,6 +213,15 @@ pub struct Counts {
     pub loses: usize,
     pub creates: usize,
     pub error: usize,
+    /// Materials that fail the check.
+    #[serde(default)]
+    pub failing: usize,
+    /// Materials whose verdict is in `fail_on` but does not fail (waived, or a warning).
+    #[serde(default)]
+    pub suppressed: usize,
+    /// Findings waived, of materials and files.
+    #[serde(default)]
+    pub waived_findings: usize,
 }
 
 /// How the materials were rendered.
@@ -193,6 +234,12 @@ pub struct AuditSettings {
     pub tolerance: f64,
     pub ring_tolerance: f64,
     pub fail_on: Vec<Verdict>,
+    /// The rules that did not run (`--select`, `--ignore`).
+    #[serde(default)]
+    pub skipped_rules: Vec<String>,
+    /// Whether a fix was asked: the check then counts what is left after it.
+    #[serde(default)]
+    pub fix: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -204,7 +251,11 @@ pub struct AuditReport {
     /// Set in a shard's report (`--shard K/N`): which part it is, and the whole run's inputs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<ShardRun>,
+    /// Whether the files as they were pass the check.
     pub passed: bool,
+    /// With a fix: whether what is left after it passes (the exit code's verdict).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub passed_after_fix: Option<bool>,
     pub counts: Counts,
     pub files: Vec<AuditedFile>,
     pub materials: Vec<AuditedMaterial>,
@@ -243,9 +294,41 @@ impl AuditReport {
                 Verdict::Error => &mut counts.error,
             } += 1;
         }
-        let fails = |v: Verdict| self.settings.fail_on.contains(&v);
-        let file_failed = counts.files_failed > 0 && fails(Verdict::Error);
-        self.passed = !file_failed && !self.materials.iter().any(|m| fails(m.verdict));
+        counts.failing = self.materials.iter().filter(|m| m.fails).count();
+        counts.suppressed = self
+            .materials
+            .iter()
+            .filter(|m| m.suppressed.is_some())
+            .count();
+        counts.waived_findings = self
+            .materials
+            .iter()
+            .flat_map(|m| &m.findings)
+            .chain(self.files.iter().flat_map(|f| &f.findings))
+            .filter(|f| f.waived.is_some())
+            .count();
+        let file_failed = (counts.files_failed > 0
+            && self.settings.fail_on.contains(&Verdict::Error))
+            || self
+                .files
+                .iter()
+                .flat_map(|f| &f.findings)
+                .any(super::waivers::counts);
+        self.passed = !file_failed && counts.failing == 0;
+        // What a fix leaves: a rewritten (or re-audited) material's state after it, any
+        // other's as it was.
+        self.passed_after_fix = self.settings.fix.then(|| {
+            !file_failed
+                && !self
+                    .materials
+                    .iter()
+                    .any(|m| m.after.as_ref().map_or(m.fails, |a| a.fails))
+        });
         self.counts = counts;
+    }
+
+    /// Whether the check passes: with a fix, on what is left after it (as ruff's `--fix`).
+    pub fn check_passed(&self) -> bool {
+        self.passed_after_fix.unwrap_or(self.passed)
     }
 }

@@ -3,6 +3,7 @@
 //! conserving twin | difference), its numbers and its findings with their fixes.
 
 use super::table::{counts, file_findings, older_blender, order, pct};
+use crate::audit::waivers::said;
 use crate::audit::{AuditReport, AuditedMaterial};
 use crate::plural::count;
 use crate::report::page::{banner, escape, page_css};
@@ -10,7 +11,12 @@ use crate::report::page::{banner, escape, page_css};
 /// `pictures[i]` is material i's picture (report order), relative to the page.
 pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) -> String {
     let c = &report.counts;
-    let verdict = if report.passed { "PASS" } else { "FAIL" };
+    // With a fix, the banner is the exit code's: what is left after it.
+    let verdict = if report.check_passed() {
+        "PASS"
+    } else {
+        "FAIL"
+    };
     let mut s = format!(
         "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
          <title>gloffuse audit: {verdict}</title><style>\n{}\
@@ -21,7 +27,7 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
          img{{image-rendering:pixelated;width:384px;display:block;margin:.4em 0}}\
          .cap{{display:flex;width:384px;font-size:12px;color:#555}}.cap span{{flex:1;text-align:center}}\
          code{{background:#f4f4f4;padding:0 .2em}}</style></head><body>\n",
-        page_css(report.passed)
+        page_css(report.check_passed())
     );
     // On a failing page, the counts that fail it stand out; on a passing one, none does.
     let tally: Vec<String> = counts(report)
@@ -50,6 +56,7 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             .collect::<Vec<_>>()
             .join(", "),
     );
+    let detail = format!("{detail}{}", suppressed_words(report));
     s.push_str(&banner(&format!("gloffuse audit: {verdict}"), &detail));
     s.push_str(&format!(
         "<p>Each picture shows the material as authored in a white furnace (a uniformly lit \
@@ -132,6 +139,12 @@ fn card(m: &AuditedMaterial, picture: Option<String>) -> String {
             pct(Some(opacity))
         ));
     }
+    if let Some(why) = &m.suppressed {
+        s.push_str(&format!(
+            "<p class=\"suppressed\">Suppressed: {}</p>\n",
+            escape(why)
+        ));
+    }
     if let Some(why) = &m.no_fix {
         s.push_str(&format!("<p>{}</p>\n", escape(why)));
     }
@@ -158,10 +171,51 @@ fn card(m: &AuditedMaterial, picture: Option<String>) -> String {
                     .as_ref()
                     .map(|t| format!(" In the twin: {}.", escape(t)))
                     .unwrap_or_default()
+                    + &waived_words(f)
             ));
         }
         s.push_str("</ul>\n");
     }
     s.push_str("</div>\n");
+    s
+}
+
+/// A finding's waiver (or its severity below error), in words for the page.
+fn waived_words(f: &crate::audit::Finding) -> String {
+    match &f.waived {
+        Some(w) => format!(" <b>Waived:</b> {}.", escape(&said(w))),
+        None if f.severity != crate::audit::rules::Severity::Error => {
+            format!(" <b>Severity:</b> {}.", f.severity.key())
+        }
+        None => String::new(),
+    }
+}
+
+/// The banner's words on what does not fail: suppressed materials, waived findings, and the
+/// files as they were when a fix changed the verdict.
+fn suppressed_words(report: &AuditReport) -> String {
+    let c = &report.counts;
+    let mut s = String::new();
+    if c.suppressed > 0 {
+        s.push_str(&format!(
+            " {} not failing (waived, or below error severity).",
+            count(c.suppressed, "material", "materials")
+        ));
+    }
+    if c.waived_findings > 0 {
+        s.push_str(&format!(
+            " {} waived.",
+            count(c.waived_findings, "finding", "findings")
+        ));
+    }
+    if report
+        .passed_after_fix
+        .is_some_and(|after| after != report.passed)
+    {
+        s.push_str(&format!(
+            " Before the fix: {}.",
+            if report.passed { "PASS" } else { "FAIL" }
+        ));
+    }
     s
 }

@@ -3,6 +3,8 @@
 //! users' files (or a shard's report.json) and is shown through [`terminal`], so none can
 //! drive the terminal or start a line of its own.
 
+use crate::audit::rules::Severity;
+use crate::audit::waivers::said;
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Verdict};
 use crate::plural::count;
 use crate::report::escape::terminal;
@@ -34,7 +36,7 @@ pub fn render(report: &AuditReport) -> String {
         "verdict", "mean", "rim", "twin", "material (file) — findings"
     ));
     for (_, m) in order(report) {
-        let rules: Vec<&str> = m.findings.iter().map(|f| f.rule.as_str()).collect();
+        let rules: Vec<String> = m.findings.iter().map(finding_label).collect();
         s.push_str(&format!(
             "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
             m.verdict.key(),
@@ -51,6 +53,20 @@ pub fn render(report: &AuditReport) -> String {
         ));
         if m.verdict != Verdict::Ok {
             s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
+        }
+        if let Some(why) = &m.suppressed {
+            s.push_str(&format!("{:<36}suppressed: {}\n", "", terminal(why)));
+        }
+        for f in &m.findings {
+            if let Some(w) = &f.waived {
+                s.push_str(&format!(
+                    "{:<36}waived {} at {}: {}\n",
+                    "",
+                    terminal(&f.rule),
+                    terminal(&f.node),
+                    terminal(&said(w))
+                ));
+            }
         }
         if let Some(why) = &m.no_fix {
             s.push_str(&format!("{:<36}{}\n", "", terminal(why)));
@@ -87,13 +103,42 @@ pub fn render(report: &AuditReport) -> String {
         0 => String::new(),
         n => format!(", {} could not be audited", count(n, "file", "files")),
     };
+    let mut notes = String::new();
+    if report.counts.suppressed > 0 {
+        notes.push_str(&format!(
+            ", {} not failing (waived, or below error severity)",
+            count(report.counts.suppressed, "material", "materials")
+        ));
+    }
+    if report.counts.waived_findings > 0 {
+        notes.push_str(&format!(
+            ", {} waived",
+            count(report.counts.waived_findings, "finding", "findings")
+        ));
+    }
+    let fix = match report.passed_after_fix {
+        Some(after) if after != report.passed => format!(
+            "; after the fix: {} (the exit code's)",
+            if after { "PASS" } else { "FAIL" }
+        ),
+        _ => String::new(),
+    };
     s.push_str(&format!(
-        "\n{}: {}{unread} (failing on: {})\n",
+        "\n{}: {}{unread}{notes} (failing on: {}){fix}\n",
         if report.passed { "PASS" } else { "FAIL" },
         counts(report).map(|(_, words)| words).join(", "),
         failing.join(", ")
     ));
     s
+}
+
+/// A finding's rule as the table lists it: marked when it is waived or not an error.
+fn finding_label(f: &crate::audit::Finding) -> String {
+    match (&f.waived, f.severity) {
+        (Some(_), _) => format!("{} (waived)", f.rule),
+        (None, Severity::Error) => f.rule.clone(),
+        (None, severity) => format!("{} ({})", f.rule, severity.key()),
+    }
 }
 
 /// The materials' counts by verdict, in words (`0 ok`, `1 loses energy`, `2 errors`), each
@@ -112,7 +157,10 @@ pub(super) fn counts(report: &AuditReport) -> [(bool, String); 4] {
         (Verdict::Error, c.error, "error", "errors"),
     ]
     .map(|(verdict, n, one, many)| {
-        let failing = n > 0 && report.settings.fail_on.contains(&verdict);
+        let failing = report
+            .materials
+            .iter()
+            .any(|m| m.verdict == verdict && m.fails);
         (failing, count(n, one, many))
     })
 }
