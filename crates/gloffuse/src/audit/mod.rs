@@ -166,16 +166,7 @@ fn audit_files(
     let fix_targets = fix_targets(o, &files, blender);
     let mut twins = TwinGroups::new(blender);
     let mut predictor = Predictor::new(blender.version);
-    let total: usize = counts.iter().sum();
-    progress.begin(
-        &format!(
-            "auditing {} in {} with Blender {}",
-            count(total, "material", "materials"),
-            count(files.len(), "file", "files"),
-            blender.version_string
-        ),
-        total as u64,
-    );
+    begin(progress, &counts, blender);
     // Fixes make files beside the user's and replace them: a stop waits for the next check
     // (between files, before a replacement), and then says what was written.
     let _hold = o.blender.cancel.hold();
@@ -235,6 +226,20 @@ fn audit_files(
     progress.end();
     report.finish();
     Ok(report)
+}
+
+/// The progress begun: the materials of every file to audit.
+fn begin(progress: &dyn Progress, counts: &[usize], blender: &Blender) {
+    let total: usize = counts.iter().sum();
+    progress.begin(
+        &format!(
+            "auditing {} in {} with Blender {}",
+            count(total, "material", "materials"),
+            count(counts.len(), "file", "files"),
+            blender.version_string
+        ),
+        total as u64,
+    );
 }
 
 /// The files this run audits (its shard's, when sharded) and their material counts; a

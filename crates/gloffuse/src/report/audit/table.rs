@@ -36,49 +36,7 @@ pub fn render(report: &AuditReport) -> String {
         "verdict", "mean", "rim", "twin", "material (file) — findings"
     ));
     for (_, m) in order(report) {
-        let rules: Vec<String> = m.findings.iter().map(finding_label).collect();
-        s.push_str(&format!(
-            "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
-            m.verdict.key(),
-            pct(m.mean),
-            pct(m.rim),
-            pct(m.twin_mean),
-            terminal(&m.material),
-            terminal(short(&m.file)),
-            if rules.is_empty() {
-                String::new()
-            } else {
-                format!(" — {}", terminal(&rules.join(", ")))
-            }
-        ));
-        if m.verdict != Verdict::Ok {
-            s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
-        }
-        if let Some(why) = &m.suppressed {
-            s.push_str(&format!("{:<36}suppressed: {}\n", "", terminal(why)));
-        }
-        for f in &m.findings {
-            if let Some(w) = &f.waived {
-                s.push_str(&format!(
-                    "{:<36}waived {} at {}: {}\n",
-                    "",
-                    terminal(&f.rule),
-                    terminal(&f.node),
-                    terminal(&said(w))
-                ));
-            }
-        }
-        if let Some(why) = &m.no_fix {
-            s.push_str(&format!("{:<36}{}\n", "", terminal(why)));
-        }
-        if let Some(after) = m.after.as_ref().filter(|a| a.rewritten) {
-            s.push_str(&format!(
-                "{:<36}after the fix: {} at {}\n",
-                "",
-                after.verdict.key(),
-                pct(after.mean)
-            ));
-        }
+        s.push_str(&material_lines(m));
     }
     for f in &report.files {
         s.push_str(&file_lines(f));
@@ -129,6 +87,55 @@ pub fn render(report: &AuditReport) -> String {
         counts(report).map(|(_, words)| words).join(", "),
         failing.join(", ")
     ));
+    s
+}
+
+/// A material's line, then its reason, what suppresses it, its waived findings and its fix.
+fn material_lines(m: &AuditedMaterial) -> String {
+    let mut s = String::new();
+    let rules: Vec<String> = m.findings.iter().map(finding_label).collect();
+    s.push_str(&format!(
+        "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
+        m.verdict.key(),
+        pct(m.mean),
+        pct(m.rim),
+        pct(m.twin_mean),
+        terminal(&m.material),
+        terminal(short(&m.file)),
+        if rules.is_empty() {
+            String::new()
+        } else {
+            format!(" — {}", terminal(&rules.join(", ")))
+        }
+    ));
+    if m.verdict != Verdict::Ok {
+        s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
+    }
+    if let Some(why) = &m.suppressed {
+        s.push_str(&format!("{:<36}suppressed: {}\n", "", terminal(why)));
+    }
+    for f in &m.findings {
+        if let Some(w) = &f.waived {
+            s.push_str(&format!(
+                "{:<36}waived {} at {}: {}\n",
+                "",
+                terminal(&f.rule),
+                terminal(&f.node),
+                terminal(&said(w))
+            ));
+        }
+    }
+    if let Some(why) = &m.no_fix {
+        s.push_str(&format!("{:<36}{}\n", "", terminal(why)));
+    }
+    if let Some(after) = m.after.as_ref().filter(|a| a.rewritten) {
+        s.push_str(&format!(
+            "{:<36}after the fix: {} at {}\n",
+            "",
+            after.verdict.key(),
+            pct(after.mean)
+        ));
+    }
     s
 }
 
