@@ -133,6 +133,20 @@ fn waivers_and_severities(label: &'static str, blender: PathBuf) {
     assert_eq!(report["counts"]["failing"], 0);
     assert_eq!(report["counts"]["waived_findings"], 4);
 
+    // The files' own properties disregarded, only the configuration waives.
+    let (code, report, stderr) = audit(
+        &blender,
+        &[
+            waived.as_os_str(),
+            no_render,
+            "--no-property-waivers".as_ref(),
+        ],
+    );
+    assert_eq!(code, 1, "Blender {label}: {stderr}");
+    assert_eq!(material(&report, "waived-material")["fails"], true);
+    assert_eq!(material(&report, "waived-config")["fails"], false);
+    assert!(findings(material(&report, "bad-waivers"), "invalid-waiver").is_empty());
+
     // The not waived and the half waived materials fail, and so does the run.
     let (code, report, stderr) = audit(&blender, &[root.as_os_str(), no_render]);
     assert_eq!(code, 1, "Blender {label}: {stderr}");

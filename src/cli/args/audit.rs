@@ -81,6 +81,11 @@ pub struct AuditArgs {
     #[arg(long, value_name = "RULE-ID,...", value_delimiter = ',')]
     pub ignore: Vec<String>,
 
+    /// Disregard the files' own gloffuse_ignore properties (a file's author then cannot
+    /// waive its findings; gloffuse.toml still does), as ruff's --ignore-noqa.
+    #[arg(long)]
+    pub no_property_waivers: bool,
+
     /// The rules alone: no furnace render (each material judged by its findings and the
     /// integrator's predictions).
     #[arg(long)]
@@ -180,6 +185,7 @@ impl AuditArgs {
             blender: self.blender.options(self.json),
             select: self.select.clone(),
             ignore: self.ignore.clone(),
+            property_waivers: !self.no_property_waivers,
         }
     }
 }

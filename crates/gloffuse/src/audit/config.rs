@@ -409,4 +409,20 @@ mod tests {
             .to_string();
         assert!(message.contains("a/gloffuse.toml, line 1"), "{message}");
     }
+
+    /// The example in docs/AUDIT.md is a configuration this reads.
+    #[test]
+    fn the_documented_example_reads() {
+        let doc = include_str!("../../../../docs/AUDIT.md");
+        let example = doc.split("```toml\n").nth(1).expect("a toml example");
+        let example = example.split("```").next().unwrap();
+        let c = parse(example).unwrap();
+        assert_eq!(c.severity["toon-smooth"], Severity::Warning);
+        assert_eq!(c.waivers.len(), 1);
+        assert!(c.waivers[0].applies(
+            "glossy-single-scatter",
+            Path::new("props/cars/a.blend"),
+            Some("Brushed steel")
+        ));
+    }
 }

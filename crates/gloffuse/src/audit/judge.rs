@@ -142,7 +142,11 @@ pub fn judge_material(
     let measured = grid
         .zip(cells)
         .map(|(g, (c, t))| (g.brightness(c), g.brightness(t)));
-    let (verdict, reason) = verdict(m, &findings, measured, judging);
+    // A verdict names a finding that counts where one does (not a waived one beside it).
+    let mut counting_first: Vec<&Finding> = findings.iter().collect();
+    counting_first.sort_by_key(|f| !waivers::counts(f));
+    let counting_first: Vec<Finding> = counting_first.into_iter().cloned().collect();
+    let (verdict, reason) = verdict(m, &counting_first, measured, judging);
     let own = measured.and_then(|(b, _)| b);
     let twin = measured.and_then(|(_, t)| t);
     let fix = fix_choice::choose(verdict, &findings, m.replaced, own.zip(twin), judging);

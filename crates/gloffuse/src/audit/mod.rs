@@ -74,6 +74,9 @@ pub struct AuditOptions {
     pub select: Vec<String>,
     /// Rules that do not run, as ruff's `--ignore`.
     pub ignore: Vec<String>,
+    /// Whether the files' own `gloffuse_ignore` properties waive findings (as ruff's
+    /// `--ignore-noqa` turned around: false disregards them; gloffuse.toml still counts).
+    pub property_waivers: bool,
 }
 
 impl Default for AuditOptions {
@@ -89,6 +92,7 @@ impl Default for AuditOptions {
             blender: BlenderOptions::default(),
             select: Vec::new(),
             ignore: Vec::new(),
+            property_waivers: true,
         }
     }
 }
@@ -182,7 +186,8 @@ fn audit_files(
     let skip = o.skipped_rules();
     let invalid_waiver_runs = !skip.iter().any(|id| id == "invalid-waiver");
     for ((file, materials), fix) in files.iter().zip(&counts).zip(fix_targets) {
-        let policy = Policy::new(configs.for_file(file)?, file, invalid_waiver_runs);
+        let policy = Policy::new(configs.for_file(file)?, file, invalid_waiver_runs)
+            .with_properties(o.property_waivers);
         let settings = JobSettings {
             skip: &skip,
             blender,
@@ -305,6 +310,7 @@ fn empty_report(o: &AuditOptions, blender: &Blender) -> AuditReport {
             ring_tolerance: o.judging.ring_tolerance,
             fail_on: o.judging.fail_on.clone(),
             skipped_rules: o.skipped_rules(),
+            property_waivers: o.property_waivers,
             fix: o.fix != FixTarget::None,
         },
         shard: None,

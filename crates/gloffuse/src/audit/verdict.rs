@@ -240,6 +240,13 @@ pub struct AuditSettings {
     /// Whether a fix was asked: the check then counts what is left after it.
     #[serde(default)]
     pub fix: bool,
+    /// Whether the files' own `gloffuse_ignore` properties waived findings.
+    #[serde(default = "yes")]
+    pub property_waivers: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -330,5 +337,57 @@ impl AuditReport {
     /// Whether the check passes: with a fix, on what is left after it (as ruff's `--fix`).
     pub fn check_passed(&self) -> bool {
         self.passed_after_fix.unwrap_or(self.passed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(fix: bool, materials: serde_json::Value) -> AuditReport {
+        serde_json::from_value(serde_json::json!({
+            "gloffuse_version": "0", "blender_version": "4.5.15", "blender_program": "b",
+            "settings": {"cell": 64, "samples": 32, "seed": 0, "render": false,
+                "tolerance": 0.01, "ring_tolerance": 0.03, "fail_on": ["loses"], "fix": fix},
+            "passed": true, "counts": {"files": 0, "files_failed": 0, "materials": 0,
+                "ok": 0, "loses": 0, "creates": 0, "error": 0},
+            "files": [], "materials": materials
+        }))
+        .unwrap()
+    }
+
+    fn material(fails: bool, after: Option<bool>) -> serde_json::Value {
+        serde_json::json!({"file": "a.blend", "material": "m", "verdict": "loses",
+            "reason": "", "fails": fails, "mean": null, "center": null, "rim": null,
+            "twin_mean": null, "twin_center": null, "twin_rim": null, "replaced": 1,
+            "findings": [], "library": null,
+            "after": after.map(|fails| serde_json::json!({"rewritten": true,
+                "verdict": "ok", "mean": null, "findings": 0, "fails": fails}))})
+    }
+
+    /// With a fix, the check counts what is left after it: a material the fix repaired
+    /// passes, one it could not fix (no `after`) still fails; `passed` keeps the before.
+    #[test]
+    fn a_fix_is_judged_by_what_it_leaves() {
+        let mut r = report(true, serde_json::json!([material(true, Some(false))]));
+        r.finish();
+        assert_eq!((r.passed, r.passed_after_fix), (false, Some(true)));
+        assert!(r.check_passed());
+        let mut r = report(
+            true,
+            serde_json::json!([material(true, Some(false)), material(true, None)]),
+        );
+        r.finish();
+        assert!(!r.check_passed());
+        let mut r = report(true, serde_json::json!([material(false, Some(true))]));
+        r.finish();
+        assert!(
+            r.passed && !r.check_passed(),
+            "a fix that made it worse fails"
+        );
+        let mut r = report(false, serde_json::json!([material(true, Some(false))]));
+        r.finish();
+        assert_eq!(r.passed_after_fix, None);
+        assert!(!r.check_passed());
     }
 }

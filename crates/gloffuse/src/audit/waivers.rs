@@ -90,6 +90,9 @@ pub struct Policy<'a> {
     relative: PathBuf,
     /// Whether `invalid-waiver` runs (`--select`/`--ignore`).
     pub invalid_waiver_runs: bool,
+    /// Whether the files' own `gloffuse_ignore` properties count (not with
+    /// `--no-property-waivers`: a file's author cannot waive its own findings then).
+    pub properties: bool,
 }
 
 impl<'a> Policy<'a> {
@@ -98,7 +101,13 @@ impl<'a> Policy<'a> {
             config,
             relative: config.map_or_else(|| file.to_path_buf(), |c| relative_to(c, file)),
             invalid_waiver_runs,
+            properties: true,
         }
+    }
+
+    /// The same, with the files' own properties disregarded (or not).
+    pub fn with_properties(self, properties: bool) -> Self {
+        Policy { properties, ..self }
     }
 
     fn severity(&self, id: &str) -> Severity {
@@ -151,6 +160,7 @@ impl<'a> Policy<'a> {
         properties: &[JobWaiver],
     ) -> Option<Waived> {
         let mut read: Vec<(&JobWaiver, Vec<(Rules, String)>)> = Vec::new();
+        let properties = if self.properties { properties } else { &[] };
         for p in properties {
             let (entries, problems) = match &p.value {
                 Some(text) => parse_waiver(text),
@@ -494,6 +504,12 @@ mod tests {
         strict.material_findings("M", &mut findings, &[property(&["M"], None, "float")]);
         assert_eq!(findings[0].severity, Severity::Error);
         assert!(fails(Verdict::Ok, &findings, None, &FAIL_ON).0);
+        // Disregarded, a property waives nothing and is not read.
+        let strict = Policy::new(None, Path::new("a.blend"), true).with_properties(false);
+        let mut findings = vec![finding("toon-smooth", &["M", "T"], Some("x"))];
+        let star =
+            strict.material_findings("M", &mut findings, &[property(&["M"], Some("*: x"), "str")]);
+        assert!(star.is_none() && findings[0].waived.is_none() && findings.len() == 1);
         // Ignored, it is not reported.
         let quiet = Policy::new(None, Path::new("a.blend"), false);
         let mut findings = Vec::new();

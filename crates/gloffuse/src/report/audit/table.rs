@@ -114,8 +114,10 @@ fn material_lines(m: &AuditedMaterial) -> String {
     if let Some(why) = &m.suppressed {
         s.push_str(&format!("{:<36}suppressed: {}\n", "", terminal(why)));
     }
+    // Each waiver once: those the suppression already names are not repeated.
+    let named = m.suppressed.as_deref().unwrap_or_default();
     for f in &m.findings {
-        if let Some(w) = &f.waived {
+        if let Some(w) = f.waived.as_ref().filter(|w| !named.contains(&said(w))) {
             s.push_str(&format!(
                 "{:<36}waived {} at {}: {}\n",
                 "",
@@ -318,5 +320,68 @@ mod tests {
             "{table}"
         );
         assert_eq!(table.matches("because").count(), 1, "{table}");
+    }
+
+    /// A suppressed material and its waived finding show, with the reason and where the
+    /// waiver came from, in the table, the JUnit file (a skipped case) and the page.
+    #[test]
+    fn every_report_shows_a_waiver_with_its_reason() {
+        let finding = serde_json::json!({"rule": "glossy-single-scatter", "node": "M ▸ G",
+            "node_path": ["M", "G"], "node_type": "ShaderNodeBsdfGlossy", "kind": "loses",
+            "versions": "3.0 and later", "why": "w", "fix": "f", "predicted": null,
+            "twin": "Multiscatter GGX", "detail": {}, "severity": "error",
+            "waived": {"reason": "signed <off>", "from": "node", "where": "M ▸ G", "line": null}});
+        let report: AuditReport = serde_json::from_value(serde_json::json!({
+            "gloffuse_version": "0", "blender_version": "4.5.15", "blender_program": "b",
+            "settings": {"cell": 64, "samples": 32, "seed": 0, "render": false,
+                "tolerance": 0.01, "ring_tolerance": 0.03, "fail_on": ["loses"]},
+            "passed": true, "counts": {"files": 1, "files_failed": 0, "materials": 1,
+                "ok": 0, "loses": 1, "creates": 0, "error": 0},
+            "files": [file("a.blend", "4.5", serde_json::json!([]))],
+            "materials": [{"file": "a.blend", "material": "M", "verdict": "loses",
+                "reason": "r", "fails": false,
+                "suppressed": "loses not failing: glossy-single-scatter at M ▸ G waived: \
+                               “signed <off>” (gloffuse_ignore on node M ▸ G)",
+                "mean": null, "center": null, "rim": null, "twin_mean": null,
+                "twin_center": null, "twin_rim": null, "replaced": 1, "findings": [finding],
+                "library": null, "after": null}]
+        }))
+        .unwrap();
+        let mut report = report;
+        report.finish();
+        assert!(report.passed && report.check_passed());
+        assert_eq!(
+            (report.counts.suppressed, report.counts.waived_findings),
+            (1, 1)
+        );
+        let table = render(&report);
+        assert!(table.contains("glossy-single-scatter (waived)"), "{table}");
+        assert!(table.contains("suppressed: loses not failing"), "{table}");
+        assert!(
+            table.contains("“signed <off>” (gloffuse_ignore on node M ▸ G)"),
+            "{table}"
+        );
+        assert!(
+            table.starts_with("Audit") && table.contains("\nPASS: "),
+            "{table}"
+        );
+        let junit = super::super::junit::render(&report, "rerun");
+        assert!(
+            junit.contains("<skipped message=\"loses not failing"),
+            "{junit}"
+        );
+        assert!(junit.contains("name=\"waived\""), "{junit}");
+        assert!(junit.contains("signed &lt;off&gt;"), "{junit}");
+        let page = super::super::html::render(&report, &[None], "rerun");
+        assert!(page.contains("Waived:</b> “signed &lt;off&gt;”"), "{page}");
+        assert!(page.contains("Suppressed: loses not failing"), "{page}");
+        // The same material failing: FAIL everywhere, no skipped case.
+        report.materials[0].fails = true;
+        report.materials[0].suppressed = None;
+        report.materials[0].findings[0].waived = None;
+        report.finish();
+        assert!(!report.passed);
+        assert!(render(&report).contains("\nFAIL: "));
+        assert!(!super::super::junit::render(&report, "r").contains("<skipped"));
     }
 }
