@@ -269,6 +269,7 @@ fn files_to_audit(
 
 /// One file audited, and when asked its fix made, audited and installed. An error of the
 /// file's own becomes its entry; a stop (`Error::Interrupted`) is returned.
+#[allow(clippy::too_many_arguments)]
 fn audit_one(
     settings: &JobSettings,
     twins: &mut TwinGroups,
