@@ -6,7 +6,8 @@
 //!
 //! What fails: a material whose verdict is in `--fail-on` and rests on a finding that counts
 //! (an `error` finding, not waived), or on no finding at all (the job's error, a sphere
-//! measured above 100 % with no rule to explain it) unless `*` waives the material; and a
+//! measured above 100 % with no rule to explain it, one black through a node the audit
+//! does not know) unless `*` waives the material; and a
 //! material or file with an `info` rule's finding raised to `error` that is not waived.
 
 use std::path::{Path, PathBuf};
@@ -263,7 +264,9 @@ fn rests_on(verdict: Verdict, f: &Finding) -> bool {
             f.kind == Effect::Loses || (f.kind == Effect::Creates && f.twin.is_some())
         }
         Verdict::Creates => f.kind == Effect::Creates,
-        Verdict::Error => f.kind == Effect::Error || f.rule == "unknown-node",
+        // A material that renders black through a node the audit does not know rests on no
+        // rule: `unknown-node` is a warning wherever the node renders.
+        Verdict::Error => f.kind == Effect::Error,
         Verdict::Ok => false,
     }
 }
@@ -470,6 +473,15 @@ mod tests {
         assert_eq!(star.from, "material");
         let (fail, why) = fails(Verdict::Creates, &findings, Some(&star), &FAIL_ON);
         assert!(!fail && why.unwrap().starts_with("creates waived"));
+        // Black through an unknown node (a warning): the error rests on no rule.
+        let mut unknown = vec![finding("unknown-node", &["M", "Script"], None)];
+        policy.material_findings("M", &mut unknown, &[]);
+        assert_eq!(unknown[0].severity, Severity::Warning);
+        assert_eq!(
+            fails(Verdict::Error, &unknown, None, &FAIL_ON),
+            (true, None)
+        );
+        assert!(!fails(Verdict::Error, &unknown, Some(&star), &FAIL_ON).0);
         // Not in --fail-on: nothing to say.
         assert_eq!(
             fails(Verdict::Creates, &findings, None, &[Verdict::Error]),
