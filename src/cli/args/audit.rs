@@ -29,8 +29,8 @@ pub(super) const AUDIT_EXAMPLES: &str = "Examples:
 
 What fails (exit 1): a material whose verdict is in --fail-on, unless every finding that
 verdict rests on is waived or below error severity; a verdict no finding explains (a sphere
-measured above 100 % with no creating rule, a job's error) is waived only by `*` on the
-material. An info rule raised to error by gloffuse.toml fails by itself. Waived findings
+measured above 100 % with no creating rule, a black render through a node the audit does
+not know, a job's error) is waived only by `*` on the material. An info rule raised to error by gloffuse.toml fails by itself. Waived findings
 stay in every report, with their reason and where the waiver came from.
 
 Waivers: a material's or node's custom property gloffuse_ignore = \"RULE-ID: reason\"

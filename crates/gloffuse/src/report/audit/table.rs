@@ -74,16 +74,21 @@ pub fn render(report: &AuditReport) -> String {
             count(report.counts.waived_findings, "finding", "findings")
         ));
     }
+    // With a fix, the verdict is the exit code's: what is left after the fix.
     let fix = match report.passed_after_fix {
         Some(after) if after != report.passed => format!(
-            "; after the fix: {} (the exit code's)",
-            if after { "PASS" } else { "FAIL" }
+            "; before the fix: {}",
+            if report.passed { "PASS" } else { "FAIL" }
         ),
         _ => String::new(),
     };
     s.push_str(&format!(
         "\n{}: {}{unread}{notes} (failing on: {}){fix}\n",
-        if report.passed { "PASS" } else { "FAIL" },
+        if report.check_passed() {
+            "PASS"
+        } else {
+            "FAIL"
+        },
         counts(report).map(|(_, words)| words).join(", "),
         failing.join(", ")
     ));
