@@ -158,7 +158,7 @@ pub fn judge_material(
         material: m.name.clone(),
         verdict,
         reason,
-        fails,
+        fails: Some(fails),
         suppressed,
         mean: own.map(|b| b.mean),
         center: own.map(|b| b.center),

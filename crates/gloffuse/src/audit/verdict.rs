@@ -126,9 +126,11 @@ pub struct After {
     pub verdict: Verdict,
     pub mean: Option<f64>,
     pub findings: usize,
-    /// Whether it fails the check after the fix (what the exit code of a fix counts).
+    /// Whether it fails the check after the fix (what the exit code of a fix counts). Always
+    /// set by gloffuse; a report without it (hand-made, older) is read as its verdict in
+    /// `fail_on`.
     #[serde(default)]
-    pub fails: bool,
+    pub fails: Option<bool>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -140,8 +142,10 @@ pub struct AuditedMaterial {
     pub reason: String,
     /// Whether it fails the check: its verdict is in `fail_on` and rests on a finding that
     /// counts (or on none, unwaived), or an `info` rule's finding raised to `error` counts.
+    /// Always set by gloffuse; a report without it (hand-made, older) is read as its verdict
+    /// in `fail_on` ([`AuditReport::finish`]).
     #[serde(default)]
-    pub fails: bool,
+    pub fails: Option<bool>,
     /// Why a verdict in `fail_on` does not fail: its findings waived or below `error`.
     #[serde(default)]
     pub suppressed: Option<String>,
@@ -170,6 +174,13 @@ pub struct AuditedMaterial {
     #[serde(skip)]
     pub fix: Option<MaterialFix>,
     pub after: Option<After>,
+}
+
+impl AuditedMaterial {
+    /// Whether it fails the check.
+    pub fn failing(&self) -> bool {
+        self.fails == Some(true)
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -301,7 +312,15 @@ impl AuditReport {
                 Verdict::Error => &mut counts.error,
             } += 1;
         }
-        counts.failing = self.materials.iter().filter(|m| m.fails).count();
+        // A report read back without `fails` (hand-made, or older): its verdicts decide.
+        let fail_on = self.settings.fail_on.clone();
+        for m in &mut self.materials {
+            m.fails.get_or_insert(fail_on.contains(&m.verdict));
+            if let Some(a) = &mut m.after {
+                a.fails.get_or_insert(fail_on.contains(&a.verdict));
+            }
+        }
+        counts.failing = self.materials.iter().filter(|m| m.failing()).count();
         counts.suppressed = self
             .materials
             .iter()
@@ -326,10 +345,11 @@ impl AuditReport {
         // other's as it was.
         self.passed_after_fix = self.settings.fix.then(|| {
             !file_failed
-                && !self
-                    .materials
-                    .iter()
-                    .any(|m| m.after.as_ref().map_or(m.fails, |a| a.fails))
+                && !self.materials.iter().any(|m| {
+                    m.after
+                        .as_ref()
+                        .map_or(m.failing(), |a| a.fails == Some(true))
+                })
         });
         self.counts = counts;
     }
@@ -389,5 +409,14 @@ mod tests {
         r.finish();
         assert_eq!(r.passed_after_fix, None);
         assert!(!r.check_passed());
+        // Without `fails` (a hand-made or older report), the verdict in fail_on decides.
+        let mut bare = material(false, Some(false));
+        bare.as_object_mut().unwrap().remove("fails");
+        bare["after"].as_object_mut().unwrap().remove("fails");
+        let mut r = report(true, serde_json::json!([bare]));
+        r.finish();
+        assert_eq!(r.materials[0].fails, Some(true));
+        assert_eq!(r.materials[0].after.as_ref().unwrap().fails, Some(false));
+        assert_eq!((r.passed, r.check_passed()), (false, true));
     }
 }

@@ -50,7 +50,7 @@ pub fn render(report: &AuditReport, rerun: &str) -> String {
 }
 
 fn case(m: &AuditedMaterial, rerun: &str) -> TestCase {
-    let status = if m.fails {
+    let status = if m.failing() {
         let mut status = TestCaseStatus::non_success(NonSuccessKind::Failure);
         status.set_message(xml_attribute(&format!("{}: {}", m.verdict.key(), m.reason)));
         let findings: Vec<String> = m

@@ -174,7 +174,7 @@ pub(super) fn counts(report: &AuditReport) -> [(bool, String); 4] {
         let failing = report
             .materials
             .iter()
-            .any(|m| m.verdict == verdict && m.fails);
+            .any(|m| m.verdict == verdict && m.failing());
         (failing, count(n, one, many))
     })
 }
@@ -381,7 +381,7 @@ mod tests {
         assert!(page.contains("Waived:</b> “signed &lt;off&gt;”"), "{page}");
         assert!(page.contains("Suppressed: loses not failing"), "{page}");
         // The same material failing: FAIL everywhere, no skipped case.
-        report.materials[0].fails = true;
+        report.materials[0].fails = Some(true);
         report.materials[0].suppressed = None;
         report.materials[0].findings[0].waived = None;
         report.finish();
