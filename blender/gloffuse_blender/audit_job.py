@@ -15,7 +15,9 @@
 # document's "fix" list of the materials Rust chose from an earlier run's
 # verdicts), the job applies those materials' replacements, saves the copy and
 # audits the copy instead. A material that cannot be audited gets an error and
-# the run goes on; a file that cannot be opened exits 1 (run_main).
+# the run goes on; a file that cannot be opened exits 1 (run_main). Each
+# material's `gloffuse_ignore` properties (its own and its nodes', into its
+# groups) are reported as they are, under "waivers": gloffuse parses them.
 # ---------------------------------------------------------------------------
 import json
 import os
@@ -60,6 +62,10 @@ from .runtime import (
 AUDIT_BOUNCES = {"max_bounces": 64, "diffuse_bounces": 8, "glossy_bounces": 64,
                  "transmission_bounces": 64, "transparent_max_bounces": 64, "volume_bounces": 16}
 
+
+# The custom property that carries a waiver (crates/gloffuse/src/audit/waivers.rs
+# reads its text; the job only reports it).
+WAIVER_PROPERTY = "gloffuse_ignore"
 
 # Blender holds at most 8 UV maps on a mesh.
 UV_MAPS_MAX = 8
@@ -108,13 +114,44 @@ def scan_file(rules, groups):
         entry = {"name": material.name,
                  "library": material.library.filepath if material.library else None,
                  "users": material.users, "cell": None, "twin_cell": None, "replaced": 0,
-                 "findings": [], "error": None, "_material": material}
+                 "findings": [], "error": None, "waivers": [], "_material": material}
         try:
             entry["findings"], entry["error"] = scan_material(material, rules, groups)
         except Exception as error:  # one material's problem is its own
             entry["error"] = "scan failed: %s: %s" % (type(error).__name__, error)
+        try:
+            entry["waivers"] = material_waivers(material)
+        except Exception as error:  # a waiver that cannot be read waives nothing
+            entry["waivers"] = [waiver_entry([material.name], "Material", error)]
         entries.append(entry)
     return entries
+
+
+def waiver_entry(path, node_type, value):
+    """A waiver as the result line carries it: its text, or only its type when
+    it is not text (an int, a group of properties, what reading it raised)."""
+    text = value if isinstance(value, str) else None
+    return {"node": path, "node_type": node_type, "value": text, "type": type(value).__name__}
+
+
+def material_waivers(material):
+    """The `gloffuse_ignore` properties of `material` and of every node in its
+    tree and, by group node, in the groups it uses (each group once per path)."""
+    found = []
+    if WAIVER_PROPERTY in material.keys():
+        found.append(waiver_entry([material.name], "Material", material[WAIVER_PROPERTY]))
+    tree = material_node_tree(material)
+    todo = [(tree, [material.name], ())] if tree is not None else []
+    while todo:
+        tree, path, stack = todo.pop()
+        for node in tree.nodes:
+            node_path = path + [node.name]
+            if WAIVER_PROPERTY in node.keys():
+                found.append(waiver_entry(node_path, node.bl_idname, node[WAIVER_PROPERTY]))
+            group = getattr(node, "node_tree", None) if node.bl_idname == "ShaderNodeGroup" else None
+            if group is not None and group.name not in stack and len(stack) < 64:
+                todo.append((group, node_path, stack + (group.name,)))
+    return found
 
 
 def group_needs(entries, groups):

@@ -104,9 +104,10 @@ CONTRACT = {
     "audit_material": {
         "required": {
             "name": "", "library": "", "users": "", "cell": "", "twin_cell": "", "replaced": "",
-            "findings": "audit_finding[]", "error": ""
+            "findings": "audit_finding[]", "error": "", "waivers": "audit_waiver[]"
         }
     },
+    "audit_waiver": {"required": {"node": "", "node_type": "", "value": "", "type": ""}},
     "audit_finding": {
         "required": {"rule": "", "node": "", "node_type": "", "detail": "", "twin": ""},
         "optional": {"metal_twin": ""}

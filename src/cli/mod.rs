@@ -4,9 +4,10 @@
 //! Exit codes, one rule each:
 //!
 //! - 0: the command succeeded (for `verify` and `refresh`: every sphere passed; for `audit`:
-//!   no material has a verdict the check fails on);
+//!   no material fails the check: a verdict in `--fail-on` that no waiver or severity
+//!   suppresses, counted after the fix when one is asked, as ruff's `--fix`);
 //! - 1: a check failed (`verify` or `refresh` found a sphere outside its tolerance, `audit`
-//!   a material with a failing verdict);
+//!   a material that fails);
 //! - 2: an error (bad input, Blender failed, an output could not be written);
 //! - 128 + the signal's number when stopped by a signal: 130 for Ctrl-C (SIGINT), 143 for
 //!   SIGTERM (`timeout`, a CI cancel), 129 for SIGHUP. Blender is stopped and nothing is
@@ -359,7 +360,7 @@ fn audit(
     write_audit_junit(a.junit.as_deref(), &report, &rerun)?;
     let out = summary(out, err, &[a.junit.as_deref()]);
     emit(out, a.json, &report, gloffuse::report::audit::table::render)?;
-    Ok(verdict(report.passed || a.exit_zero))
+    Ok(verdict(report.check_passed() || a.exit_zero))
 }
 
 fn write_audit_junit(path: Option<&Path>, report: &AuditReport, rerun: &str) -> Result<()> {
@@ -417,7 +418,7 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
     if !m.json.as_deref().is_some_and(is_stdout) {
         out.write_all(gloffuse::report::audit::table::render(report).as_bytes())?;
     }
-    Ok(verdict(report.passed || m.exit_zero))
+    Ok(verdict(report.check_passed() || m.exit_zero))
 }
 
 /// The command line this process was started with, quoted for a shell: how to rerun it.

@@ -96,9 +96,15 @@ def bad_cases(docs):
         ("an audit result's finding without its twin", "audit_result",
          {"blender_version": "5.0.0", "file": "a.blend", "scan_seconds": 0.1,
           "materials": [{"name": "m", "library": None, "users": 1, "cell": None, "twin_cell": None,
-                         "replaced": 0, "error": None,
+                         "replaced": 0, "error": None, "waivers": [],
                          "findings": [{"rule": "r", "node": ["m"], "node_type": "Material", "detail": {}}]}]},
          "the document.materials[0].findings[0]: missing field 'twin'"),
+        ("an audit result's waiver without its type", "audit_result",
+         {"blender_version": "5.0.0", "file": "a.blend", "scan_seconds": 0.1,
+          "materials": [{"name": "m", "library": None, "users": 1, "cell": None, "twin_cell": None,
+                         "replaced": 0, "error": None, "findings": [],
+                         "waivers": [{"node": ["m"], "node_type": "Material", "value": "*: x"}]}]},
+         "the document.materials[0].waivers[0]: missing field 'type'"),
     ]
 
 

@@ -213,7 +213,9 @@ mod tests {
     use std::path::Path;
 
     use super::*;
-    use crate::audit::job::{FixItem, JobFinding, JobFixed, JobMaterial, JobResult, document};
+    use crate::audit::job::{
+        FixItem, JobFinding, JobFixed, JobMaterial, JobResult, JobWaiver, document,
+    };
     use crate::bench::audit::library_document;
     use crate::fit::Coefficients;
     use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
@@ -335,6 +337,7 @@ mod tests {
             ("audit_result", struct_fields::<JobResult>()),
             ("audit_material", struct_fields::<JobMaterial>()),
             ("audit_finding", struct_fields::<JobFinding>()),
+            ("audit_waiver", struct_fields::<JobWaiver>()),
             ("audit_fixed", struct_fields::<JobFixed>()),
         ] {
             let listed = checker.all_fields(kind);

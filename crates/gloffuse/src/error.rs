@@ -189,6 +189,12 @@ pub enum Field {
     AllowDowngrade,
     /// A .blend file or folder to audit.
     AuditPath,
+    /// An audit configuration file (`gloffuse.toml`).
+    AuditConfig,
+    /// The only audit rules that run.
+    Select,
+    /// Audit rules that do not run.
+    Ignore,
     /// Which audit verdicts fail the check.
     FailOn,
     /// The fixed copy of one audited .blend to write.
@@ -263,6 +269,9 @@ impl Field {
             Field::Into => "file to update",
             Field::AllowDowngrade => "permission to downgrade the file",
             Field::AuditPath => "path to audit",
+            Field::AuditConfig => "audit configuration",
+            Field::Select => "rules to run",
+            Field::Ignore => "rules to skip",
             Field::FailOn => "verdicts that fail",
             Field::Fix => "fixed copy",
             Field::FixDir => "folder for fixed copies",

@@ -21,7 +21,33 @@ pub(super) const AUDIT_EXAMPLES: &str = "Examples:
   gloffuse audit lib.blend --fix lib-fixed.blend a fixed copy, audited again (before and after)
   gloffuse audit assets/ --fix-dir fixed/        fixed copies of every file, same layout
   gloffuse audit lib.blend --in-place            fix the file itself (the old one kept as lib.blend1)
-  gloffuse audit assets/ --no-render             the rules alone, no Blender render";
+  gloffuse audit assets/ --no-render             the rules alone, no Blender render
+  gloffuse audit assets/ --ignore toon-smooth,filter-glossy
+                                                 every rule but these two
+  gloffuse audit assets/ --select glossy-single-scatter --no-render
+                                                 only that rule
+
+What fails (exit 1): a material whose verdict is in --fail-on, unless every finding that
+verdict rests on is waived or below error severity; a verdict no finding explains (a sphere
+measured above 100 % with no creating rule, a black render through a node the audit does
+not know, a job's error) is waived only by `*` on the material. An info rule raised to error by gloffuse.toml fails by itself. Waived findings
+stay in every report, with their reason and where the waiver came from.
+
+Waivers: a material's or node's custom property gloffuse_ignore = \"RULE-ID: reason\"
+(several separated by ;, * for every rule), and gloffuse.toml, the nearest one in the
+file's folder or above (ruff's way; none are merged):
+  [severity]
+  toon-smooth = \"warning\"           # error | warning | info
+  [[waiver]]
+  rules = [\"glossy-single-scatter\"] # or [\"*\"]
+  reason = \"the brushed look is signed off\"
+  files = [\"props/**/*.blend\"]      # optional: globs relative to the file's folder
+  materials = [\"Chrome\"]            # optional: exact material names
+docs/AUDIT.md (Waivers and severities) has the whole story.
+
+With a fix (--fix, --fix-dir, --in-place) the exit code counts what is left after the fix,
+as ruff's --fix does: a file whose only failure the fix removes exits 0. The reports keep
+the verdicts before the fix (and each material's after).";
 
 #[derive(Args, Debug)]
 pub struct AuditArgs {
@@ -40,9 +66,25 @@ pub struct AuditArgs {
     pub ring_tolerance: f64,
 
     /// The verdicts that fail the check (exit 1), comma-separated: loses, creates, error,
-    /// ok [default: loses,creates,error].
+    /// ok [default: loses,creates,error]. A verdict fails only when a finding it rests on
+    /// counts (error severity, not waived): see below.
     #[arg(long, value_name = "VERDICT,...", value_delimiter = ',', value_parser = parse_verdict)]
     pub fail_on: Vec<Verdict>,
+
+    /// Run only these rules (comma-separated ids, as ruff's --select): the others are not
+    /// looked for, and the conserving twin leaves their nodes as they are [default: all].
+    #[arg(long, value_name = "RULE-ID,...", value_delimiter = ',')]
+    pub select: Vec<String>,
+
+    /// Do not run these rules (comma-separated ids, as ruff's --ignore): their findings are
+    /// not reported and their nodes are left alone by the twin and the fix.
+    #[arg(long, value_name = "RULE-ID,...", value_delimiter = ',')]
+    pub ignore: Vec<String>,
+
+    /// Disregard the files' own gloffuse_ignore properties (a file's author then cannot
+    /// waive its findings; gloffuse.toml still does), as ruff's --ignore-noqa.
+    #[arg(long)]
+    pub no_property_waivers: bool,
 
     /// The rules alone: no furnace render (each material judged by its findings and the
     /// integrator's predictions).
@@ -62,7 +104,8 @@ pub struct AuditArgs {
     pub seed: u32,
 
     /// Write a fixed copy of the one audited file here (flagged lobes replaced by their
-    /// conserving twins), then audit the copy: the report shows before and after.
+    /// conserving twins), then audit the copy: the report shows before and after, and the
+    /// exit code what is left after the fix.
     #[arg(long, value_name = "OUT.blend", conflicts_with_all = ["fix_dir", "in_place"])]
     pub fix: Option<PathBuf>,
 
@@ -140,6 +183,9 @@ impl AuditArgs {
             allow_downgrade: self.allow_downgrade,
             shard: self.shard,
             blender: self.blender.options(self.json),
+            select: self.select.clone(),
+            ignore: self.ignore.clone(),
+            property_waivers: !self.no_property_waivers,
         }
     }
 }

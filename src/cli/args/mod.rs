@@ -101,7 +101,8 @@ pub enum Command {
     /// same material with every flagged lobe replaced by its conserving equivalent
     /// (Multiscatter GGX, or a gloffuse group where Blender has none). Each material gets ok,
     /// loses, creates or error. The files are only read, unless you ask for a fix.
-    /// Exit code 0: no material has a verdict in --fail-on; 1: some have; 2: bad input.
+    /// Exit code 0: no material fails the check (a verdict in --fail-on that no waiver or
+    /// severity suppresses; with a fix, counted after it); 1: some do; 2: bad input.
     #[command(after_long_help = AUDIT_EXAMPLES)]
     Audit(AuditArgs),
     /// Measure E_avg in your Blender, fit new coefficients from it, then verify them.
@@ -169,6 +170,9 @@ pub fn flag(field: Field) -> String {
         Field::Into => "--into",
         Field::AllowDowngrade => "--allow-downgrade",
         Field::AuditPath => "PATH",
+        Field::AuditConfig => "gloffuse.toml",
+        Field::Select => "--select",
+        Field::Ignore => "--ignore",
         Field::FailOn => "--fail-on",
         Field::Fix => "--fix",
         Field::FixDir => "--fix-dir",

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use super::job::{FixItem, FixOutput, JobSettings};
 use super::rules::Predictor;
 use super::twins::{TwinGroups, run_twinned};
+use super::waivers::Policy;
 use super::{
     After, AuditOptions, AuditedFile, AuditedMaterial, FixTarget, Fixed, judge, judged, read_grids,
 };
@@ -190,12 +191,14 @@ impl<'a> Destination<'a> {
 
 /// The judged file (`audited`: its entry and materials) fixed into `destination`, the fix
 /// audited again and installed; returns the path installed, if any.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn fix_file(
     s: &JobSettings,
     twins: &mut TwinGroups,
     real: &Path,
     destination: Destination,
     o: &AuditOptions,
+    policy: &Policy,
     predictor: &mut Predictor,
     audited: &mut (AuditedFile, Vec<AuditedMaterial>),
 ) -> Result<Option<PathBuf>, Error> {
@@ -215,7 +218,7 @@ pub(super) fn fix_file(
         compress: plan.input.compressed(),
         materials: &chosen,
     };
-    let (replaced, after) = fix_and_audit(s, twins, real, fixed, o, predictor)?;
+    let (replaced, after) = fix_and_audit(s, twins, real, fixed, o, policy, predictor)?;
     o.blender.cancel.check()?;
     let Some((mut entry, path)) = install_fix(target, temp, replaced)? else {
         return Ok(None);
@@ -266,13 +269,14 @@ fn fix_and_audit(
     file: &Path,
     fixed: FixOutput,
     o: &AuditOptions,
+    policy: &Policy,
     predictor: &mut Predictor,
 ) -> Result<(usize, Result<Vec<AuditedMaterial>, String>), Error> {
     let job = run_twinned(s, twins, file, Some(fixed))?;
     let replaced = job.result.fixed.as_ref().map_or(0, |f| f.replaced);
     let after = read_grids(&job).and_then(|image| {
         judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
-        Ok(judged(fixed.path, &job, image.as_ref(), o, predictor).1)
+        Ok(judged(fixed.path, &job, image.as_ref(), o, policy, predictor).1)
     });
     Ok((replaced, after.map_err(|e| e.to_string())))
 }
@@ -327,6 +331,7 @@ fn attach_after(materials: &mut [AuditedMaterial], after: Vec<AuditedMaterial>) 
                 verdict: a.verdict,
                 mean: a.mean,
                 findings: a.findings.len(),
+                fails: a.fails,
             });
     }
 }

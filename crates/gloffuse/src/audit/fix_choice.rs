@@ -144,6 +144,8 @@ mod tests {
             predicted: None,
             twin: Some("t".into()),
             detail,
+            severity: Default::default(),
+            waived: None,
         }
     }
 

@@ -90,6 +90,21 @@ pub struct JobFinding {
     pub twin: Option<String>,
 }
 
+/// A `gloffuse_ignore` property as the job read it, on a material or on a node it uses.
+/// Its text is parsed here (waivers.rs), never in the job.
+#[derive(Clone, Debug, Deserialize)]
+pub struct JobWaiver {
+    /// The material's name, or the path from it down to the node (by node names).
+    pub node: Vec<String>,
+    /// `Material`, or the node's type.
+    pub node_type: String,
+    /// The property's text; none when it is not text (`type` says what it is).
+    pub value: Option<String>,
+    /// The property's Python type (`str`, `int`, `IDPropertyGroup`, …).
+    #[serde(rename = "type")]
+    pub value_type: String,
+}
+
 /// A material as the job reports it.
 #[derive(Clone, Debug, Deserialize)]
 pub struct JobMaterial {
@@ -106,6 +121,9 @@ pub struct JobMaterial {
     pub findings: Vec<JobFinding>,
     #[serde(default)]
     pub error: Option<String>,
+    /// Its `gloffuse_ignore` properties and its nodes'.
+    #[serde(default)]
+    pub waivers: Vec<JobWaiver>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -151,6 +169,8 @@ pub struct JobSettings<'a> {
     pub materials: usize,
     /// Told the fraction of the render done (by Cycles' estimate) while it runs.
     pub on_fraction: &'a (dyn Fn(f64) + Sync),
+    /// Rules that do not run (`--select`, `--ignore`): left out of the document.
+    pub skip: &'a [String],
 }
 
 /// A finished job: its result, its log, and the EXRs when it rendered (the materials', and
@@ -194,7 +214,11 @@ pub fn run_job(s: &JobSettings, file: &Path, fix: Option<FixOutput>) -> Result<J
     let exr = run_dir.join("audit.exr");
     let twin_exr = run_dir.join("audit-twins.exr");
     let materials = fix.as_ref().map_or(&[][..], |f| f.materials);
-    let params = document(s.groups, s.render, &exr, &twin_exr, materials);
+    let mut params = document(s.groups, s.render, &exr, &twin_exr, materials);
+    params
+        .audit
+        .rules
+        .retain(|r| !s.skip.iter().any(|id| id == r.id));
     let script = run_dir.join("gloffuse-audit.py");
     write_output(&script, assemble(&params, Job::Audit).as_bytes())?;
     let log = run_dir.join("blender.log");

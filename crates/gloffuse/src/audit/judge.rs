@@ -5,6 +5,7 @@ use super::fix_choice;
 use super::job::{JobFinding, JobMaterial, JobRun};
 use super::rules::{Effect, Predictor, rule};
 use super::verdict::{AuditJudging, AuditedMaterial, Brightness, Finding, Verdict};
+use super::waivers::{self, Policy};
 use crate::Error;
 use crate::verify::image::Rgba;
 use crate::verify::stats::{SphereStats, sphere_stats};
@@ -119,6 +120,8 @@ pub fn word(f: &JobFinding, predictor: &mut Predictor) -> Finding {
         predicted,
         twin: f.twin.clone(),
         detail: f.detail.clone(),
+        severity: known.map_or_else(Default::default, |r| r.severity),
+        waived: None,
     }
 }
 
@@ -149,28 +152,40 @@ fn pct(x: f64) -> String {
     format!("{:.1} %", 100.0 * x)
 }
 
-/// The verdict on one material of `file`.
+/// The verdict on one material of `file`, and whether it fails the check under `policy`
+/// (its waivers and severities).
 pub fn judge_material(
     file: &str,
     m: &JobMaterial,
     grid: Option<&Grid>,
     judging: &AuditJudging,
+    policy: &Policy,
     predictor: &mut Predictor,
 ) -> AuditedMaterial {
-    let findings: Vec<Finding> = m.findings.iter().map(|f| word(f, predictor)).collect();
+    let mut findings: Vec<Finding> = m.findings.iter().map(|f| word(f, predictor)).collect();
+    let star = policy.material_findings(&m.name, &mut findings, &m.waivers);
     let cells = m.cell.map(|c| (c, m.twin_cell.unwrap_or(c)));
     let measured = grid
         .zip(cells)
         .map(|(g, (c, t))| (g.brightness(c), g.brightness(t)));
-    let (verdict, reason) = verdict(m, &findings, measured, judging);
+    // A verdict names a finding that counts where one does (not a waived one beside it).
+    let mut counting_first: Vec<&Finding> = findings.iter().collect();
+    counting_first.sort_by_key(|f| !waivers::counts(f));
+    let counting_first: Vec<Finding> = counting_first.into_iter().cloned().collect();
+    let (verdict, reason) = verdict(m, &counting_first, measured, judging);
     let own = measured.and_then(|(b, _)| b);
     let twin = measured.and_then(|(_, t)| t);
     let fix = fix_choice::choose(verdict, &findings, m.replaced, own.zip(twin), judging);
+    let (fails, suppressed) = waivers::fails(verdict, &findings, star.as_ref(), &judging.fail_on);
+    // A material whose failing verdict is waived (or only a warning) is left as it is.
+    let fix = if suppressed.is_some() { Ok(None) } else { fix };
     AuditedMaterial {
         file: file.to_string(),
         material: m.name.clone(),
         verdict,
         reason,
+        fails: Some(fails),
+        suppressed,
         mean: own.map(|b| b.mean),
         center: own.map(|b| b.center),
         rim: own.map(|b| b.rim),

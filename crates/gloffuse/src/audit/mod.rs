@@ -5,6 +5,7 @@
 //! path, `user_blend`), audited again. Files are streamed: each file's grid is handed to the
 //! caller and dropped before the next file starts.
 
+pub mod config;
 pub mod files;
 mod fix;
 pub mod fix_choice;
@@ -15,10 +16,11 @@ pub mod rules;
 mod shard_cost;
 mod twins;
 pub mod verdict;
+pub mod waivers;
 
 pub use verdict::{
     After, AuditJudging, AuditReport, AuditSettings, AuditedFile, AuditedMaterial, Counts, Finding,
-    Fixed, ShardInput, ShardRun, Verdict,
+    Fixed, ShardInput, ShardRun, Verdict, Waived,
 };
 
 use std::path::{Path, PathBuf};
@@ -35,11 +37,13 @@ use crate::shard::Shard;
 use crate::verify::RenderSettings;
 use crate::verify::image::{Rgba, read_rgba};
 use crate::{Error, Field, Hint};
+use config::Configs;
 use fix::{Destination, FixPlan, check_fix_targets, fix_file, fix_targets};
 use job::{JobRun, JobSettings};
 use judge::{Grid, judge_material};
-use rules::Predictor;
+use rules::{Predictor, RULES, known_ids, rule};
 use twins::{TwinGroups, run_twinned};
+use waivers::Policy;
 
 /// Where fixed files go.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -66,6 +70,13 @@ pub struct AuditOptions {
     /// Audit only this part of the files (the same split on every machine).
     pub shard: Option<Shard>,
     pub blender: BlenderOptions,
+    /// The only rules that run (empty: every rule), as ruff's `--select`.
+    pub select: Vec<String>,
+    /// Rules that do not run, as ruff's `--ignore`.
+    pub ignore: Vec<String>,
+    /// Whether the files' own `gloffuse_ignore` properties waive findings (as ruff's
+    /// `--ignore-noqa` turned around: false disregards them; gloffuse.toml still counts).
+    pub property_waivers: bool,
 }
 
 impl Default for AuditOptions {
@@ -79,7 +90,25 @@ impl Default for AuditOptions {
             allow_downgrade: false,
             shard: None,
             blender: BlenderOptions::default(),
+            select: Vec::new(),
+            ignore: Vec::new(),
+            property_waivers: true,
         }
+    }
+}
+
+impl AuditOptions {
+    /// The catalogue's rules that do not run: those not selected, and those ignored.
+    pub fn skipped_rules(&self) -> Vec<String> {
+        RULES
+            .iter()
+            .map(|r| r.id)
+            .filter(|id| {
+                (!self.select.is_empty() && !self.select.iter().any(|s| s == id))
+                    || self.ignore.iter().any(|s| s == id)
+            })
+            .map(String::from)
+            .collect()
     }
 }
 
@@ -98,10 +127,10 @@ pub fn audit(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    // Bad input fails before Blender is looked for.
-    let files = checked_files(o)?;
+    // Bad input (a bad gloffuse.toml too) fails before Blender is looked for.
+    let (files, mut configs) = checked_files(o)?;
     let blender = find_for_files(&o.blender, &files, Field::AuditPath, None, progress)?;
-    audit_files(&blender, o, &files, progress, on_file)
+    audit_files(&blender, o, &files, &mut configs, progress, on_file)
 }
 
 /// [`audit`] with a Blender already found.
@@ -111,21 +140,28 @@ pub fn audit_with(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    audit_files(blender, o, &checked_files(o)?, progress, on_file)
+    let (files, mut configs) = checked_files(o)?;
+    audit_files(blender, o, &files, &mut configs, progress, on_file)
 }
 
-/// The options checked, and the files they name.
-fn checked_files(o: &AuditOptions) -> Result<Vec<PathBuf>, Error> {
+/// The options checked, the files they name, and the configurations that hold them (each
+/// read and checked now).
+fn checked_files(o: &AuditOptions) -> Result<(Vec<PathBuf>, Configs), Error> {
     check(o)?;
     let files = files::blend_files(&o.paths)?;
     check_fix_targets(o, &files)?;
-    Ok(files)
+    let mut configs = Configs::default();
+    for file in &files {
+        configs.for_file(file)?;
+    }
+    Ok((files, configs))
 }
 
 fn audit_files(
     blender: &Blender,
     o: &AuditOptions,
     files: &[PathBuf],
+    configs: &mut Configs,
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
@@ -134,16 +170,7 @@ fn audit_files(
     let fix_targets = fix_targets(o, &files, blender);
     let mut twins = TwinGroups::new(blender);
     let mut predictor = Predictor::new(blender.version);
-    let total: usize = counts.iter().sum();
-    progress.begin(
-        &format!(
-            "auditing {} in {} with Blender {}",
-            count(total, "material", "materials"),
-            count(files.len(), "file", "files"),
-            blender.version_string
-        ),
-        total as u64,
-    );
+    begin(progress, &counts, blender);
     // Fixes make files beside the user's and replace them: a stop waits for the next check
     // (between files, before a replacement), and then says what was written.
     let _hold = o.blender.cancel.hold();
@@ -156,8 +183,13 @@ fn audit_files(
         other => other,
     };
     let mut done = 0u64;
+    let skip = o.skipped_rules();
+    let invalid_waiver_runs = !skip.iter().any(|id| id == "invalid-waiver");
     for ((file, materials), fix) in files.iter().zip(&counts).zip(fix_targets) {
+        let policy = Policy::new(configs.for_file(file)?, file, invalid_waiver_runs)
+            .with_properties(o.property_waivers);
         let settings = JobSettings {
+            skip: &skip,
             blender,
             options: &o.blender,
             groups: None,
@@ -172,6 +204,7 @@ fn audit_files(
                 file,
                 fix,
                 o,
+                &policy,
                 &mut predictor,
                 progress,
             )?;
@@ -200,6 +233,20 @@ fn audit_files(
     Ok(report)
 }
 
+/// The progress begun: the materials of every file to audit.
+fn begin(progress: &dyn Progress, counts: &[usize], blender: &Blender) {
+    let total: usize = counts.iter().sum();
+    progress.begin(
+        &format!(
+            "auditing {} in {} with Blender {}",
+            count(total, "material", "materials"),
+            count(counts.len(), "file", "files"),
+            blender.version_string
+        ),
+        total as u64,
+    );
+}
+
 /// The files this run audits (its shard's, when sharded) and their material counts; a
 /// shard's place in the whole run goes into `report`.
 fn files_to_audit(
@@ -222,17 +269,21 @@ fn files_to_audit(
 
 /// One file audited, and when asked its fix made, audited and installed. An error of the
 /// file's own becomes its entry; a stop (`Error::Interrupted`) is returned.
+#[allow(clippy::too_many_arguments)]
 fn audit_one(
     settings: &JobSettings,
     twins: &mut TwinGroups,
     file: &Path,
     fix: Result<Option<FixPlan>, Error>,
     o: &AuditOptions,
+    policy: &Policy,
     predictor: &mut Predictor,
     progress: &dyn Progress,
 ) -> Result<FileAudit, Error> {
-    let audited =
-        fix.and_then(|fix| audit_file(settings, twins, file, fix.as_ref(), o, predictor, progress));
+    let audited = fix.and_then(|fix| {
+        let fix = fix.as_ref();
+        audit_file(settings, twins, file, fix, o, policy, predictor, progress)
+    });
     match audited {
         Err(e @ Error::Interrupted { .. }) => Err(e),
         Err(e) => Ok((
@@ -259,9 +310,13 @@ fn empty_report(o: &AuditOptions, blender: &Blender) -> AuditReport {
             tolerance: o.judging.tolerance,
             ring_tolerance: o.judging.ring_tolerance,
             fail_on: o.judging.fail_on.clone(),
+            skipped_rules: o.skipped_rules(),
+            property_waivers: o.property_waivers,
+            fix: o.fix != FixTarget::None,
         },
         shard: None,
         passed: false,
+        passed_after_fix: None,
         counts: Counts::default(),
         files: Vec::new(),
         materials: Vec::new(),
@@ -278,6 +333,15 @@ fn check(o: &AuditOptions) -> Result<(), Error> {
                 Field::Arguments,
                 value,
                 format!("a {what} from 0 to 100 %"),
+            ));
+        }
+    }
+    for (ids, field) in [(&o.select, Field::Select), (&o.ignore, Field::Ignore)] {
+        if let Some(id) = ids.iter().find(|id| rule(id).is_none()) {
+            return Err(Error::input(
+                field,
+                id,
+                Hint::text(format!("rule ids, comma-separated, from: {}", known_ids())),
             ));
         }
     }
@@ -305,12 +369,14 @@ type FileAudit = (
     Option<PathBuf>,
 );
 
+#[allow(clippy::too_many_arguments)]
 fn audit_file(
     s: &JobSettings,
     twins: &mut TwinGroups,
     file: &Path,
     fix: Option<&FixPlan>,
     o: &AuditOptions,
+    policy: &Policy,
     predictor: &mut Predictor,
     progress: &dyn Progress,
 ) -> Result<FileAudit, Error> {
@@ -328,10 +394,19 @@ fn audit_file(
     let job = run_twinned(s, twins, &real, None)?;
     let image = read_grids(&job)?;
     judge::check_grid(&job, image.as_ref(), o.settings.cell)?;
-    let mut audited = judged(file, &job, image.as_ref(), o, predictor);
+    let mut audited = judged(file, &job, image.as_ref(), o, policy, predictor);
     let installed = match destination {
         None => None,
-        Some(destination) => fix_file(s, twins, &real, destination, o, predictor, &mut audited)?,
+        Some(destination) => fix_file(
+            s,
+            twins,
+            &real,
+            destination,
+            o,
+            policy,
+            predictor,
+            &mut audited,
+        )?,
     };
     let (file_entry, materials) = audited;
     Ok((file_entry, materials, image, installed))
@@ -389,12 +464,13 @@ fn read_grid(exr: &Path) -> Result<Rgba, Error> {
     })
 }
 
-/// The file's entry and its materials' verdicts.
+/// The file's entry and its materials' verdicts, their findings counted under `policy`.
 fn judged(
     file: &Path,
     job: &JobRun,
     image: Option<&Rgba>,
     o: &AuditOptions,
+    policy: &Policy,
     predictor: &mut Predictor,
 ) -> (AuditedFile, Vec<AuditedMaterial>) {
     let cell = o.settings.cell as usize;
@@ -410,8 +486,15 @@ fn judged(
         .result
         .materials
         .iter()
-        .map(|m| judge_material(&name, m, grid.as_ref(), &o.judging, predictor))
+        .map(|m| judge_material(&name, m, grid.as_ref(), &o.judging, policy, predictor))
         .collect();
+    let mut findings: Vec<_> = job
+        .result
+        .file_findings
+        .iter()
+        .map(|f| judge::word(f, predictor))
+        .collect();
+    policy.file_findings(&mut findings);
     let entry = AuditedFile {
         file: name,
         saved_by: read_header(file)
@@ -419,12 +502,7 @@ fn judged(
             .and_then(|h| h.version)
             .map(|v| v.to_string()),
         error: None,
-        findings: job
-            .result
-            .file_findings
-            .iter()
-            .map(|f| judge::word(f, predictor))
-            .collect(),
+        findings,
         materials: job.result.materials.len(),
         log: Some(job.log.display().to_string()),
         render_seconds: job.result.render_seconds,

@@ -36,11 +36,42 @@ impl Effect {
     }
 }
 
+/// How much a finding counts: only `error` findings fail the check (a judging rule's
+/// through the verdict it gives, an `info` rule's by itself); `warning` and `info` are
+/// reported.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Severity {
+    #[default]
+    Error,
+    Warning,
+    Info,
+}
+
+impl Severity {
+    pub const ALL: [Severity; 3] = [Severity::Error, Severity::Warning, Severity::Info];
+
+    pub fn key(self) -> &'static str {
+        match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+            Severity::Info => "info",
+        }
+    }
+
+    pub fn from_key(key: &str) -> Option<Severity> {
+        Severity::ALL.into_iter().find(|s| s.key() == key)
+    }
+}
+
 /// One rule of the audit.
 #[derive(Clone, Copy, Debug)]
 pub struct Rule {
     pub id: &'static str,
     pub effect: Effect,
+    /// How much a finding of it counts unless a configuration says otherwise: only an
+    /// `error` finding fails the check.
+    pub severity: Severity,
     /// The first Blender version it applies to.
     pub from: BlenderVersion,
     /// The first version it no longer applies to (none: every later one).
@@ -60,6 +91,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "glossy-single-scatter",
         effect: Effect::Loses,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "a single-scatter glossy lobe (GGX, Beckmann or Ashikhmin–Shirley) loses the light \
@@ -70,6 +102,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "anisotropic-multiscatter",
         effect: Effect::Loses,
+        severity: Severity::Error,
         // 3.x's Multiscatter GGX is a random walk between microfacets, which conserves an
         // anisotropic lobe too; 4.0 replaced it by the albedo-scaled single scatter.
         from: v(4, 0),
@@ -82,6 +115,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "metallic-single-scatter",
         effect: Effect::Loses,
+        severity: Severity::Error,
         from: v(4, 3),
         before: None,
         why: "a single-scatter Metallic lobe loses the light that bounces between microfacets",
@@ -90,6 +124,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "glass-single-scatter",
         effect: Effect::Loses,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "single-scatter rough glass loses light at every interface (22 % at roughness 0.5, \
@@ -99,6 +134,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "refraction-single-scatter",
         effect: Effect::Loses,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "the Refraction BSDF has no multiscatter option in any Blender: rough refraction \
@@ -108,6 +144,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "principled-single-scatter",
         effect: Effect::Loses,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "Principled BSDF with the GGX distribution is not energy-compensated",
@@ -116,6 +153,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "principled-creates-energy",
         effect: Effect::Creates,
+        severity: Severity::Error,
         from: v(3, 0),
         before: Some(v(4, 0)),
         why: "Principled BSDF before 4.0 adds its specular layer to an undimmed diffuse base: a \
@@ -126,6 +164,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "mix-fresnel-layering",
         effect: Effect::Loses,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "a Mix Shader driven by Fresnel or Layer Weight weights the whole glossy lobe by the \
@@ -137,6 +176,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "add-reflecting",
         effect: Effect::Creates,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "an Add Shader of two reflecting closures reflects the sum of both: up to twice the \
@@ -148,6 +188,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "color-above-one",
         effect: Effect::Creates,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "a BSDF colour above 1 reflects more light than arrives",
@@ -156,6 +197,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "toon-smooth",
         effect: Effect::Creates,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "a Toon BSDF with Smooth above 0 is not normalised: it can reflect more than it \
@@ -165,6 +207,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "filter-glossy",
         effect: Effect::Info,
+        severity: Severity::Warning,
         from: v(3, 0),
         before: None,
         why: "Filter Glossy raises roughness after Cycles computes its compensation, so rough \
@@ -174,6 +217,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "load-warning",
         effect: Effect::Info,
+        severity: Severity::Warning,
         from: v(3, 0),
         before: None,
         why: "Blender reported an error opening the file and loaded the rest: what it could not \
@@ -183,6 +227,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "missing-texture",
         effect: Effect::Error,
+        severity: Severity::Error,
         from: v(3, 0),
         before: None,
         why: "an image the material uses is missing, so Blender renders it magenta",
@@ -191,6 +236,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "linked-library",
         effect: Effect::Info,
+        severity: Severity::Info,
         from: v(3, 0),
         before: None,
         why: "the material or a group it uses is linked from another .blend (audit that file \
@@ -200,6 +246,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "emission",
         effect: Effect::Info,
+        severity: Severity::Info,
         from: v(3, 0),
         before: None,
         why: "the material emits light, so its furnace brightness includes what it emits (it is \
@@ -209,6 +256,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "holdout",
         effect: Effect::Info,
+        severity: Severity::Info,
         from: v(3, 0),
         before: None,
         why: "a Holdout cuts the material out of the image: where it covers the sphere there is \
@@ -218,6 +266,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "volume",
         effect: Effect::Info,
+        severity: Severity::Info,
         from: v(3, 0),
         before: None,
         why: "the material has a volume, which the furnace renders inside the sphere",
@@ -226,6 +275,7 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "depends-on-scene",
         effect: Effect::Info,
+        severity: Severity::Info,
         from: v(3, 0),
         before: None,
         why: "the material reads what the furnace's sphere cannot know (a mesh's attributes or \
@@ -237,22 +287,32 @@ pub const RULES: &[Rule] = &[
     Rule {
         id: "unknown-node",
         effect: Effect::Info,
+        severity: Severity::Warning,
         from: v(3, 0),
         before: None,
         why: "a node the audit does not know (an OSL script, a custom node, a group without a \
               tree): its light is measured by the furnace only",
         fix: "check the node by hand",
     },
+    Rule {
+        id: "invalid-waiver",
+        effect: Effect::Info,
+        severity: Severity::Warning,
+        from: v(3, 0),
+        before: None,
+        why: "a `gloffuse_ignore` custom property that gloffuse cannot read: what it cannot \
+              read waives nothing",
+        fix: "write the property as text, `RULE-ID: reason`, several separated by `;` (`*` for \
+              every rule)",
+    },
     // The PBR range rules (issue 41): plausible albedos, read off constant colours (an
     // unlinked socket or an RGB node) in sRGB, without a render. Metal: a Principled BSDF
     // with Metallic at or above 0.9, or a Glossy BSDF's colour; non-metal: Metallic at or
-    // below 0.1, or a Diffuse BSDF's colour (docs/AUDIT.md, "PBR ranges"). Intended severities, for
-    // the per-rule severities to come: pbr-albedo-range info, pbr-dark-albedo and
-    // pbr-metal-reflectance warning.
+    // below 0.1, or a Diffuse BSDF's colour (docs/AUDIT.md, "PBR ranges").
     Rule {
         id: "pbr-albedo-range",
-        // Intended severity: info.
         effect: Effect::Info,
+        severity: Severity::Info,
         from: v(3, 0),
         before: None,
         why: "the colour's luminance is outside the range of Unity's Material Validator \
@@ -262,8 +322,8 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         id: "pbr-dark-albedo",
-        // Intended severity: warning.
         effect: Effect::Info,
+        severity: Severity::Warning,
         from: v(3, 0),
         before: None,
         why: "a channel of the non-metal's colour is below the dark floor of Substance's PBR \
@@ -273,8 +333,8 @@ pub const RULES: &[Rule] = &[
     },
     Rule {
         id: "pbr-metal-reflectance",
-        // Intended severity: warning.
         effect: Effect::Info,
+        severity: Severity::Warning,
         from: v(3, 0),
         before: None,
         why: "a channel of the metal's colour is below the 60–100 % metal reflectance of \
@@ -283,6 +343,14 @@ pub const RULES: &[Rule] = &[
               the material a non-metal",
     },
 ];
+
+/// The rules gloffuse reports itself, from what the job read (no detector in the job).
+pub const REPORTED_BY_GLOFFUSE: &[&str] = &["invalid-waiver"];
+
+/// Every rule id, comma-separated: what a wrong id is told.
+pub fn known_ids() -> String {
+    RULES.iter().map(|r| r.id).collect::<Vec<_>>().join(", ")
+}
 
 /// The rule `id`, if the catalogue has it.
 pub fn rule(id: &str) -> Option<&'static Rule> {
@@ -394,7 +462,8 @@ mod tests {
         assert_eq!(m.versions(), "4.3 and later");
     }
 
-    /// docs/AUDIT.md lists every rule, with the effect and versions the catalogue gives it.
+    /// docs/AUDIT.md lists every rule, with the effect, versions and severity the catalogue
+    /// gives it.
     #[test]
     fn the_documentation_lists_every_rule_as_the_catalogue_has_it() {
         let doc = include_str!("../../../../docs/AUDIT.md");
@@ -410,6 +479,7 @@ mod tests {
             assert_eq!(row[1], format!("`{}`", rule.id), "in the catalogue's order");
             assert_eq!(row[2], rule.effect.key(), "{}", rule.id);
             assert_eq!(row[3], rule.versions(), "{}", rule.id);
+            assert_eq!(row[4], rule.severity.key(), "{}", rule.id);
         }
     }
 
@@ -452,7 +522,10 @@ mod tests {
                 "the job reports {id}, which the catalogue lacks"
             );
         }
-        for r in RULES {
+        for r in RULES
+            .iter()
+            .filter(|r| !REPORTED_BY_GLOFFUSE.contains(&r.id))
+        {
             assert!(
                 reported.contains(&r.id),
                 "no detector in the job reports {}",

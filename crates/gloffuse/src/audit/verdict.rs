@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::fix_choice::MaterialFix;
-use super::rules::Effect;
+use super::rules::{Effect, Severity};
 use crate::shard::Shard;
 
 /// What the furnace and the rules say about one material.
@@ -78,6 +78,28 @@ pub struct Finding {
     pub twin: Option<String>,
     /// What the job read off the node (distribution, roughness, …).
     pub detail: serde_json::Value,
+    /// How much it counts: only an `error` finding fails the check (the catalogue's
+    /// default, or the configuration's `[severity]`).
+    #[serde(default)]
+    pub severity: Severity,
+    /// The waiver that suppresses it, if any: it stays in the report and fails nothing.
+    #[serde(default)]
+    pub waived: Option<Waived>,
+}
+
+/// Why a finding, or a material's verdict, is suppressed: the waiver's reason and where it
+/// came from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Waived {
+    pub reason: String,
+    /// `material` or `node` (its `gloffuse_ignore` property), or `config` (a gloffuse.toml).
+    pub from: String,
+    /// The material or node (`A ▸ B`) that carries the property, or the configuration file.
+    #[serde(rename = "where")]
+    pub place: String,
+    /// The configuration's line where the `[[waiver]]` entry starts.
+    #[serde(default)]
+    pub line: Option<usize>,
 }
 
 /// Furnace brightness of one sphere (1.0 = 100 %), as the furnace shows it: where the
@@ -104,6 +126,11 @@ pub struct After {
     pub verdict: Verdict,
     pub mean: Option<f64>,
     pub findings: usize,
+    /// Whether it fails the check after the fix (what the exit code of a fix counts). Always
+    /// set by gloffuse; a report without it (hand-made, older) is read as its verdict in
+    /// `fail_on`.
+    #[serde(default)]
+    pub fails: Option<bool>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -113,6 +140,15 @@ pub struct AuditedMaterial {
     pub verdict: Verdict,
     /// Why, in words.
     pub reason: String,
+    /// Whether it fails the check: its verdict is in `fail_on` and rests on a finding that
+    /// counts (or on none, unwaived), or an `info` rule's finding raised to `error` counts.
+    /// Always set by gloffuse; a report without it (hand-made, older) is read as its verdict
+    /// in `fail_on` ([`AuditReport::finish`]).
+    #[serde(default)]
+    pub fails: Option<bool>,
+    /// Why a verdict in `fail_on` does not fail: its findings waived or below `error`.
+    #[serde(default)]
+    pub suppressed: Option<String>,
     pub mean: Option<f64>,
     pub center: Option<f64>,
     pub rim: Option<f64>,
@@ -138,6 +174,13 @@ pub struct AuditedMaterial {
     #[serde(skip)]
     pub fix: Option<MaterialFix>,
     pub after: Option<After>,
+}
+
+impl AuditedMaterial {
+    /// Whether it fails the check.
+    pub fn failing(&self) -> bool {
+        self.fails == Some(true)
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -181,6 +224,15 @@ pub struct Counts {
     pub loses: usize,
     pub creates: usize,
     pub error: usize,
+    /// Materials that fail the check.
+    #[serde(default)]
+    pub failing: usize,
+    /// Materials whose verdict is in `fail_on` but does not fail (waived, or a warning).
+    #[serde(default)]
+    pub suppressed: usize,
+    /// Findings waived, of materials and files.
+    #[serde(default)]
+    pub waived_findings: usize,
 }
 
 /// How the materials were rendered.
@@ -193,6 +245,19 @@ pub struct AuditSettings {
     pub tolerance: f64,
     pub ring_tolerance: f64,
     pub fail_on: Vec<Verdict>,
+    /// The rules that did not run (`--select`, `--ignore`).
+    #[serde(default)]
+    pub skipped_rules: Vec<String>,
+    /// Whether a fix was asked: the check then counts what is left after it.
+    #[serde(default)]
+    pub fix: bool,
+    /// Whether the files' own `gloffuse_ignore` properties waived findings.
+    #[serde(default = "yes")]
+    pub property_waivers: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -204,7 +269,11 @@ pub struct AuditReport {
     /// Set in a shard's report (`--shard K/N`): which part it is, and the whole run's inputs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<ShardRun>,
+    /// Whether the files as they were pass the check.
     pub passed: bool,
+    /// With a fix: whether what is left after it passes (the exit code's verdict).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub passed_after_fix: Option<bool>,
     pub counts: Counts,
     pub files: Vec<AuditedFile>,
     pub materials: Vec<AuditedMaterial>,
@@ -243,9 +312,111 @@ impl AuditReport {
                 Verdict::Error => &mut counts.error,
             } += 1;
         }
-        let fails = |v: Verdict| self.settings.fail_on.contains(&v);
-        let file_failed = counts.files_failed > 0 && fails(Verdict::Error);
-        self.passed = !file_failed && !self.materials.iter().any(|m| fails(m.verdict));
+        // A report read back without `fails` (hand-made, or older): its verdicts decide.
+        let fail_on = self.settings.fail_on.clone();
+        for m in &mut self.materials {
+            m.fails.get_or_insert(fail_on.contains(&m.verdict));
+            if let Some(a) = &mut m.after {
+                a.fails.get_or_insert(fail_on.contains(&a.verdict));
+            }
+        }
+        counts.failing = self.materials.iter().filter(|m| m.failing()).count();
+        counts.suppressed = self
+            .materials
+            .iter()
+            .filter(|m| m.suppressed.is_some())
+            .count();
+        counts.waived_findings = self
+            .materials
+            .iter()
+            .flat_map(|m| &m.findings)
+            .chain(self.files.iter().flat_map(|f| &f.findings))
+            .filter(|f| f.waived.is_some())
+            .count();
+        let file_failed = (counts.files_failed > 0
+            && self.settings.fail_on.contains(&Verdict::Error))
+            || self
+                .files
+                .iter()
+                .flat_map(|f| &f.findings)
+                .any(super::waivers::counts);
+        self.passed = !file_failed && counts.failing == 0;
+        // What a fix leaves: a rewritten (or re-audited) material's state after it, any
+        // other's as it was.
+        self.passed_after_fix = self.settings.fix.then(|| {
+            !file_failed
+                && !self.materials.iter().any(|m| {
+                    m.after
+                        .as_ref()
+                        .map_or(m.failing(), |a| a.fails == Some(true))
+                })
+        });
         self.counts = counts;
+    }
+
+    /// Whether the check passes: with a fix, on what is left after it (as ruff's `--fix`).
+    pub fn check_passed(&self) -> bool {
+        self.passed_after_fix.unwrap_or(self.passed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(fix: bool, materials: serde_json::Value) -> AuditReport {
+        serde_json::from_value(serde_json::json!({
+            "gloffuse_version": "0", "blender_version": "4.5.15", "blender_program": "b",
+            "settings": {"cell": 64, "samples": 32, "seed": 0, "render": false,
+                "tolerance": 0.01, "ring_tolerance": 0.03, "fail_on": ["loses"], "fix": fix},
+            "passed": true, "counts": {"files": 0, "files_failed": 0, "materials": 0,
+                "ok": 0, "loses": 0, "creates": 0, "error": 0},
+            "files": [], "materials": materials
+        }))
+        .unwrap()
+    }
+
+    fn material(fails: bool, after: Option<bool>) -> serde_json::Value {
+        serde_json::json!({"file": "a.blend", "material": "m", "verdict": "loses",
+            "reason": "", "fails": fails, "mean": null, "center": null, "rim": null,
+            "twin_mean": null, "twin_center": null, "twin_rim": null, "replaced": 1,
+            "findings": [], "library": null,
+            "after": after.map(|fails| serde_json::json!({"rewritten": true,
+                "verdict": "ok", "mean": null, "findings": 0, "fails": fails}))})
+    }
+
+    /// With a fix, the check counts what is left after it: a material the fix repaired
+    /// passes, one it could not fix (no `after`) still fails; `passed` keeps the before.
+    #[test]
+    fn a_fix_is_judged_by_what_it_leaves() {
+        let mut r = report(true, serde_json::json!([material(true, Some(false))]));
+        r.finish();
+        assert_eq!((r.passed, r.passed_after_fix), (false, Some(true)));
+        assert!(r.check_passed());
+        let mut r = report(
+            true,
+            serde_json::json!([material(true, Some(false)), material(true, None)]),
+        );
+        r.finish();
+        assert!(!r.check_passed());
+        let mut r = report(true, serde_json::json!([material(false, Some(true))]));
+        r.finish();
+        assert!(
+            r.passed && !r.check_passed(),
+            "a fix that made it worse fails"
+        );
+        let mut r = report(false, serde_json::json!([material(true, Some(false))]));
+        r.finish();
+        assert_eq!(r.passed_after_fix, None);
+        assert!(!r.check_passed());
+        // Without `fails` (a hand-made or older report), the verdict in fail_on decides.
+        let mut bare = material(false, Some(false));
+        bare.as_object_mut().unwrap().remove("fails");
+        bare["after"].as_object_mut().unwrap().remove("fails");
+        let mut r = report(true, serde_json::json!([bare]));
+        r.finish();
+        assert_eq!(r.materials[0].fails, Some(true));
+        assert_eq!(r.materials[0].after.as_ref().unwrap().fails, Some(false));
+        assert_eq!((r.passed, r.check_passed()), (false, true));
     }
 }

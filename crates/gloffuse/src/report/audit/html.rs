@@ -8,6 +8,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::table::{counts, file_findings, older_blender, order, pct};
+use crate::audit::waivers::said;
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Finding, Verdict};
 use crate::plural::count;
 use crate::report::page::{banner, escape, page_css};
@@ -15,7 +16,12 @@ use crate::report::page::{banner, escape, page_css};
 /// `pictures[i]` is material i's picture (report order), relative to the page.
 pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) -> String {
     let c = &report.counts;
-    let verdict = if report.passed { "PASS" } else { "FAIL" };
+    // With a fix, the banner is the exit code's: what is left after it.
+    let verdict = if report.check_passed() {
+        "PASS"
+    } else {
+        "FAIL"
+    };
     let mut s = format!(
         "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
          <title>gloffuse audit: {verdict}</title><style>\n{}\
@@ -30,7 +36,7 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
          table.sum td,table.sum th{{border-bottom:1px solid #ddd;padding:.2em .6em;text-align:left}}\
          table.sum td.n{{text-align:right}}\
          details pre{{white-space:pre-wrap;font-size:12px;background:#f4f4f4;padding:.4em}}</style></head><body>\n",
-        page_css(report.passed)
+        page_css(report.check_passed())
     );
     // On a failing page, the counts that fail it stand out; on a passing one, none does.
     let tally: Vec<String> = counts(report)
@@ -59,6 +65,7 @@ pub fn render(report: &AuditReport, pictures: &[Option<String>], rerun: &str) ->
             .collect::<Vec<_>>()
             .join(", "),
     );
+    let detail = format!("{detail}{}", suppressed_words(report));
     s.push_str(&banner(&format!("gloffuse audit: {verdict}"), &detail));
     s.push_str(&format!(
         "<p>Each picture shows the material as authored in a white furnace (a uniformly lit \
@@ -150,6 +157,12 @@ fn card(index: usize, m: &AuditedMaterial, picture: Option<String>) -> String {
             pct(Some(opacity))
         ));
     }
+    if let Some(why) = &m.suppressed {
+        s.push_str(&format!(
+            "<p class=\"suppressed\">Suppressed: {}</p>\n",
+            escape(why)
+        ));
+    }
     if let Some(why) = &m.no_fix {
         s.push_str(&format!("<p>{}</p>\n", escape(why)));
     }
@@ -177,6 +190,7 @@ fn card(index: usize, m: &AuditedMaterial, picture: Option<String>) -> String {
                     .as_ref()
                     .map(|t| format!(" In the twin: {}.", escape(t)))
                     .unwrap_or_default()
+                    + &waived_words(f)
             ));
         }
         s.push_str("</ul>\n");
@@ -350,13 +364,14 @@ fn fixed_card(f: &AuditedFile) -> String {
 }
 
 /// A material's findings, each once: findings that differ only by their node (a rule that
-/// fired on several nodes, or several inputs of one node) are one, with its nodes in order.
+/// fired on several nodes, or several inputs of one node) are one, with its nodes in order;
+/// a waived and an unwaived finding of one rule stay two.
 fn once_each(findings: &[Finding]) -> Vec<(&Finding, Vec<&str>)> {
     let mut kept: Vec<(&Finding, Vec<&str>)> = Vec::new();
     for f in findings {
         let same = |k: &Finding| {
-            (&k.rule, &k.why, &k.fix, &k.twin, &k.versions)
-                == (&f.rule, &f.why, &f.fix, &f.twin, &f.versions)
+            (&k.rule, &k.why, &k.fix, &k.twin, &k.versions, &k.waived, k.severity)
+                == (&f.rule, &f.why, &f.fix, &f.twin, &f.versions, &f.waived, f.severity)
         };
         match kept.iter_mut().find(|(k, _)| same(k)) {
             Some((_, nodes)) if nodes.contains(&f.node.as_str()) => {}
@@ -633,4 +648,44 @@ mod tests {
         assert!(page.contains("<b>in/a.blend</b> fixed as out/a.blend (1 lobe replaced)."));
         assert!(page.contains("<code>filter-glossy</code> in 1 file: fg."));
     }
+}
+
+/// A finding's waiver (or its severity below error), in words for the page.
+fn waived_words(f: &Finding) -> String {
+    match &f.waived {
+        Some(w) => format!(" <b>Waived:</b> {}.", escape(&said(w))),
+        None if f.severity != crate::audit::rules::Severity::Error => {
+            format!(" <b>Severity:</b> {}.", f.severity.key())
+        }
+        None => String::new(),
+    }
+}
+
+/// The banner's words on what does not fail: suppressed materials, waived findings, and the
+/// files as they were when a fix changed the verdict.
+fn suppressed_words(report: &AuditReport) -> String {
+    let c = &report.counts;
+    let mut s = String::new();
+    if c.suppressed > 0 {
+        s.push_str(&format!(
+            " {} not failing (waived, or below error severity).",
+            count(c.suppressed, "material", "materials")
+        ));
+    }
+    if c.waived_findings > 0 {
+        s.push_str(&format!(
+            " {} waived.",
+            count(c.waived_findings, "finding", "findings")
+        ));
+    }
+    if report
+        .passed_after_fix
+        .is_some_and(|after| after != report.passed)
+    {
+        s.push_str(&format!(
+            " Before the fix: {}.",
+            if report.passed { "PASS" } else { "FAIL" }
+        ));
+    }
+    s
 }

@@ -1,11 +1,13 @@
 //! The audit verdict as JUnit XML: one test suite per file, one test case per material,
-//! failing when its verdict is one the check fails on; a file that could not be audited is
-//! one failing case of its own. Names come from users' files: each attribute goes through
+//! failing when it fails the check, skipped (with why) when its failing verdict is waived or
+//! below error severity, each waived finding a `waived` property; a file that could not be
+//! audited is one failing case of its own. Names come from users' files: each attribute goes through
 //! [`xml_attribute`] and the failure's text through [`xml_text`], so the XML stays valid
 //! and every name reads as the terminal shows it (the writer escapes `<`, `&` and quotes).
 
 use quick_junit::{NonSuccessKind, Property, Report, TestCase, TestCaseStatus, TestSuite};
 
+use crate::audit::waivers::{counts, said};
 use crate::audit::{AuditReport, AuditedMaterial};
 use crate::report::escape::{xml_attribute, xml_text};
 
@@ -27,16 +29,28 @@ pub fn render(report: &AuditReport, rerun: &str) -> String {
             status.set_message(xml_attribute(error));
             suite.add_test_case(TestCase::new("(file)", status));
         }
+        // A file finding raised to error severity (gloffuse.toml), not waived.
+        let counting: Vec<String> = file
+            .findings
+            .iter()
+            .filter(|f| counts(f))
+            .map(|f| format!("{} at {}: {}", f.rule, f.node, f.why))
+            .collect();
+        if !counting.is_empty() {
+            let mut status = TestCaseStatus::non_success(NonSuccessKind::Failure);
+            status.set_message(xml_attribute(&counting.join("; ")));
+            suite.add_test_case(TestCase::new("(file findings)", status));
+        }
         for m in report.materials.iter().filter(|m| m.file == file.file) {
-            suite.add_test_case(case(report, m, rerun));
+            suite.add_test_case(case(m, rerun));
         }
         junit.add_test_suite(suite);
     }
     junit.to_string().expect("a report serialises to XML")
 }
 
-fn case(report: &AuditReport, m: &AuditedMaterial, rerun: &str) -> TestCase {
-    let status = if report.settings.fail_on.contains(&m.verdict) {
+fn case(m: &AuditedMaterial, rerun: &str) -> TestCase {
+    let status = if m.failing() {
         let mut status = TestCaseStatus::non_success(NonSuccessKind::Failure);
         status.set_message(xml_attribute(&format!("{}: {}", m.verdict.key(), m.reason)));
         let findings: Vec<String> = m
@@ -49,10 +63,22 @@ fn case(report: &AuditReport, m: &AuditedMaterial, rerun: &str) -> TestCase {
             findings.join("\n")
         )));
         status
+    } else if let Some(why) = &m.suppressed {
+        // A verdict that would fail, suppressed: skipped, with why.
+        let mut status = TestCaseStatus::skipped();
+        status.set_message(xml_attribute(why));
+        status
     } else {
         TestCaseStatus::success()
     };
     let mut case = TestCase::new(xml_attribute(&m.material), status);
+    for f in m.findings.iter().filter(|f| f.waived.is_some()) {
+        let w = f.waived.as_ref().expect("filtered");
+        case.add_property(Property::new(
+            "waived",
+            xml_attribute(&format!("{} at {}: {}", f.rule, f.node, said(w))),
+        ));
+    }
     case.set_classname(xml_attribute(&m.file));
     case.add_property(Property::new("verdict", m.verdict.key()));
     for (name, value) in [("mean", m.mean), ("rim", m.rim), ("twin_mean", m.twin_mean)] {

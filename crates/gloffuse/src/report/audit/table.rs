@@ -3,6 +3,8 @@
 //! users' files (or a shard's report.json) and is shown through [`terminal`], so none can
 //! drive the terminal or start a line of its own.
 
+use crate::audit::rules::Severity;
+use crate::audit::waivers::said;
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Verdict};
 use crate::plural::count;
 use crate::report::escape::terminal;
@@ -34,35 +36,7 @@ pub fn render(report: &AuditReport) -> String {
         "verdict", "mean", "rim", "twin", "material (file) — findings"
     ));
     for (_, m) in order(report) {
-        let rules: Vec<&str> = m.findings.iter().map(|f| f.rule.as_str()).collect();
-        s.push_str(&format!(
-            "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
-            m.verdict.key(),
-            pct(m.mean),
-            pct(m.rim),
-            pct(m.twin_mean),
-            terminal(&m.material),
-            terminal(short(&m.file)),
-            if rules.is_empty() {
-                String::new()
-            } else {
-                format!(" — {}", terminal(&rules.join(", ")))
-            }
-        ));
-        if m.verdict != Verdict::Ok {
-            s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
-        }
-        if let Some(why) = &m.no_fix {
-            s.push_str(&format!("{:<36}{}\n", "", terminal(why)));
-        }
-        if let Some(after) = m.after.as_ref().filter(|a| a.rewritten) {
-            s.push_str(&format!(
-                "{:<36}after the fix: {} at {}\n",
-                "",
-                after.verdict.key(),
-                pct(after.mean)
-            ));
-        }
+        s.push_str(&material_lines(m));
     }
     for f in &report.files {
         s.push_str(&file_lines(f));
@@ -87,13 +61,98 @@ pub fn render(report: &AuditReport) -> String {
         0 => String::new(),
         n => format!(", {} could not be audited", count(n, "file", "files")),
     };
+    let mut notes = String::new();
+    if report.counts.suppressed > 0 {
+        notes.push_str(&format!(
+            ", {} not failing (waived, or below error severity)",
+            count(report.counts.suppressed, "material", "materials")
+        ));
+    }
+    if report.counts.waived_findings > 0 {
+        notes.push_str(&format!(
+            ", {} waived",
+            count(report.counts.waived_findings, "finding", "findings")
+        ));
+    }
+    // With a fix, the verdict is the exit code's: what is left after the fix.
+    let fix = match report.passed_after_fix {
+        Some(after) if after != report.passed => format!(
+            "; before the fix: {}",
+            if report.passed { "PASS" } else { "FAIL" }
+        ),
+        _ => String::new(),
+    };
     s.push_str(&format!(
-        "\n{}: {}{unread} (failing on: {})\n",
-        if report.passed { "PASS" } else { "FAIL" },
+        "\n{}: {}{unread}{notes} (failing on: {}){fix}\n",
+        if report.check_passed() {
+            "PASS"
+        } else {
+            "FAIL"
+        },
         counts(report).map(|(_, words)| words).join(", "),
         failing.join(", ")
     ));
     s
+}
+
+/// A material's line, then its reason, what suppresses it, its waived findings and its fix.
+fn material_lines(m: &AuditedMaterial) -> String {
+    let mut s = String::new();
+    let rules: Vec<String> = m.findings.iter().map(finding_label).collect();
+    s.push_str(&format!(
+        "{:<8} {:>8} {:>8} {:>8}  {} ({}){}\n",
+        m.verdict.key(),
+        pct(m.mean),
+        pct(m.rim),
+        pct(m.twin_mean),
+        terminal(&m.material),
+        terminal(short(&m.file)),
+        if rules.is_empty() {
+            String::new()
+        } else {
+            format!(" — {}", terminal(&rules.join(", ")))
+        }
+    ));
+    if m.verdict != Verdict::Ok {
+        s.push_str(&format!("{:<36}{}\n", "", terminal(&m.reason)));
+    }
+    if let Some(why) = &m.suppressed {
+        s.push_str(&format!("{:<36}suppressed: {}\n", "", terminal(why)));
+    }
+    // Each waiver once: those the suppression already names are not repeated.
+    let named = m.suppressed.as_deref().unwrap_or_default();
+    for f in &m.findings {
+        if let Some(w) = f.waived.as_ref().filter(|w| !named.contains(&said(w))) {
+            s.push_str(&format!(
+                "{:<36}waived {} at {}: {}\n",
+                "",
+                terminal(&f.rule),
+                terminal(&f.node),
+                terminal(&said(w))
+            ));
+        }
+    }
+    if let Some(why) = &m.no_fix {
+        s.push_str(&format!("{:<36}{}\n", "", terminal(why)));
+    }
+    if let Some(after) = m.after.as_ref().filter(|a| a.rewritten) {
+        s.push_str(&format!(
+            "{:<36}after the fix: {} at {}\n",
+            "",
+            after.verdict.key(),
+            pct(after.mean)
+        ));
+    }
+    s
+}
+
+/// A finding's rule as the table lists it: marked when it is waived or not an error.
+fn finding_label(f: &crate::audit::Finding) -> String {
+    match (&f.waived, f.severity) {
+        (Some(_), _) => format!("{} (waived)", f.rule),
+        (None, Severity::Error) => f.rule.clone(),
+        (None, severity) => format!("{} ({})", f.rule, severity.key()),
+    }
 }
 
 /// The materials' counts by verdict, in words (`0 ok`, `1 loses energy`, `2 errors`), each
@@ -112,7 +171,10 @@ pub(super) fn counts(report: &AuditReport) -> [(bool, String); 4] {
         (Verdict::Error, c.error, "error", "errors"),
     ]
     .map(|(verdict, n, one, many)| {
-        let failing = n > 0 && report.settings.fail_on.contains(&verdict);
+        let failing = report
+            .materials
+            .iter()
+            .any(|m| m.verdict == verdict && m.failing());
         (failing, count(n, one, many))
     })
 }
@@ -263,5 +325,68 @@ mod tests {
             "{table}"
         );
         assert_eq!(table.matches("because").count(), 1, "{table}");
+    }
+
+    /// A suppressed material and its waived finding show, with the reason and where the
+    /// waiver came from, in the table, the JUnit file (a skipped case) and the page.
+    #[test]
+    fn every_report_shows_a_waiver_with_its_reason() {
+        let finding = serde_json::json!({"rule": "glossy-single-scatter", "node": "M ▸ G",
+            "node_path": ["M", "G"], "node_type": "ShaderNodeBsdfGlossy", "kind": "loses",
+            "versions": "3.0 and later", "why": "w", "fix": "f", "predicted": null,
+            "twin": "Multiscatter GGX", "detail": {}, "severity": "error",
+            "waived": {"reason": "signed <off>", "from": "node", "where": "M ▸ G", "line": null}});
+        let report: AuditReport = serde_json::from_value(serde_json::json!({
+            "gloffuse_version": "0", "blender_version": "4.5.15", "blender_program": "b",
+            "settings": {"cell": 64, "samples": 32, "seed": 0, "render": false,
+                "tolerance": 0.01, "ring_tolerance": 0.03, "fail_on": ["loses"]},
+            "passed": true, "counts": {"files": 1, "files_failed": 0, "materials": 1,
+                "ok": 0, "loses": 1, "creates": 0, "error": 0},
+            "files": [file("a.blend", "4.5", serde_json::json!([]))],
+            "materials": [{"file": "a.blend", "material": "M", "verdict": "loses",
+                "reason": "r", "fails": false,
+                "suppressed": "loses not failing: glossy-single-scatter at M ▸ G waived: \
+                               “signed <off>” (gloffuse_ignore on node M ▸ G)",
+                "mean": null, "center": null, "rim": null, "twin_mean": null,
+                "twin_center": null, "twin_rim": null, "replaced": 1, "findings": [finding],
+                "library": null, "after": null}]
+        }))
+        .unwrap();
+        let mut report = report;
+        report.finish();
+        assert!(report.passed && report.check_passed());
+        assert_eq!(
+            (report.counts.suppressed, report.counts.waived_findings),
+            (1, 1)
+        );
+        let table = render(&report);
+        assert!(table.contains("glossy-single-scatter (waived)"), "{table}");
+        assert!(table.contains("suppressed: loses not failing"), "{table}");
+        assert!(
+            table.contains("“signed <off>” (gloffuse_ignore on node M ▸ G)"),
+            "{table}"
+        );
+        assert!(
+            table.starts_with("Audit") && table.contains("\nPASS: "),
+            "{table}"
+        );
+        let junit = super::super::junit::render(&report, "rerun");
+        assert!(
+            junit.contains("<skipped message=\"loses not failing"),
+            "{junit}"
+        );
+        assert!(junit.contains("name=\"waived\""), "{junit}");
+        assert!(junit.contains("signed &lt;off&gt;"), "{junit}");
+        let page = super::super::html::render(&report, &[None], "rerun");
+        assert!(page.contains("Waived:</b> “signed &lt;off&gt;”"), "{page}");
+        assert!(page.contains("Suppressed: loses not failing"), "{page}");
+        // The same material failing: FAIL everywhere, no skipped case.
+        report.materials[0].fails = Some(true);
+        report.materials[0].suppressed = None;
+        report.materials[0].findings[0].waived = None;
+        report.finish();
+        assert!(!report.passed);
+        assert!(render(&report).contains("\nFAIL: "));
+        assert!(!super::super::junit::render(&report, "r").contains("<skipped"));
     }
 }
