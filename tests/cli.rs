@@ -627,9 +627,8 @@ fn sigterm_and_sighup_exit_128_plus_the_signal_and_write_nothing() {
 
 /// The text of one option in a `--help`, its lines joined by single spaces.
 fn option_help(help: &str, flag: &str) -> String {
-    let mut lines = help
-        .lines()
-        .skip_while(|l| !l.contains(&format!("{flag} ")));
+    let option = |l: &str| l.trim_start().starts_with('-') && l.contains(&format!("{flag} "));
+    let mut lines = help.lines().skip_while(|l| !option(l));
     let first = lines.next().unwrap_or_else(|| panic!("{flag} in the help"));
     let rest = lines.take_while(|l| !l.trim_start().starts_with('-'));
     std::iter::once(first)

@@ -26,12 +26,17 @@ pub(super) const AUDIT_EXAMPLES: &str = "Examples:
                                                  every rule but these two
   gloffuse audit assets/ --select glossy-single-scatter --no-render
                                                  only that rule
+  gloffuse audit assets/ --json > accepted.json  a baseline: what the studio accepts today
+  gloffuse audit assets/ --baseline accepted.json --sarif audit.sarif
+                                                 fail only on what is new or worse, and a
+                                                 SARIF log for a code-scanning service
 
 What fails (exit 1): a material whose verdict is in --fail-on, unless every finding that
 verdict rests on is waived or below error severity; a verdict no finding explains (a sphere
 measured above 100 % with no creating rule, a black render through a node the audit does
-not know, a job's error) is waived only by `*` on the material. An info rule raised to error by gloffuse.toml fails by itself. Waived findings
-stay in every report, with their reason and where the waiver came from.
+not know, a job's error) is waived only by `*` on the material. An info rule raised to
+error by gloffuse.toml fails by itself. Waived findings stay in every report, with their
+reason and where the waiver came from.
 
 Waivers: a material's or node's custom property gloffuse_ignore = \"RULE-ID: reason\"
 (several separated by ;, * for every rule), and gloffuse.toml, the nearest one in the
@@ -44,6 +49,10 @@ file's folder or above (ruff's way; none are merged):
   files = [\"props/**/*.blend\"]      # optional: globs relative to the file's folder
   materials = [\"Chrome\"]            # optional: exact material names
 docs/AUDIT.md (Waivers and severities) has the whole story.
+
+With --baseline OLD.json, each material is new, worse, better or unchanged beside the
+material of its file and name in that report, and a failing material fails the check only
+when new or worse (a file error only when the baseline had none for that file).
 
 With a fix (--fix, --fix-dir, --in-place) the exit code counts what is left after the fix,
 as ruff's --fix does: a file whose only failure the fix removes exits 0. The reports keep
@@ -134,6 +143,16 @@ pub struct AuditArgs {
     #[arg(long, value_name = "FILE.xml")]
     pub junit: Option<PathBuf>,
 
+    /// Also write a SARIF 2.1.0 log (every rule, each finding at file ▸ material ▸ node,
+    /// waivers as suppressions, each material's baseline state) for a code-scanning service.
+    #[arg(long, value_name = "FILE.sarif")]
+    pub sarif: Option<PathBuf>,
+
+    /// An earlier report (a report.json, or the JSON this command prints with --json):
+    /// fail only on materials that are new or worse than in it.
+    #[arg(long, value_name = "OLD.json")]
+    pub baseline: Option<PathBuf>,
+
     /// Audit only part K of N of the files (K from 1 to N), for a farm: every machine
     /// computes the same split, balanced by each file's material count, and `gloffuse report
     /// merge` joins the shards' reports into the one a single run gives.
@@ -186,6 +205,7 @@ impl AuditArgs {
             select: self.select.clone(),
             ignore: self.ignore.clone(),
             property_waivers: !self.no_property_waivers,
+            baseline: self.baseline.clone(),
         }
     }
 }
