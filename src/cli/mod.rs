@@ -329,7 +329,7 @@ fn audit(
     if let Some(dir) = &a.report {
         gloffuse::report::check_dir(dir)?;
     }
-    if let Some(path) = &a.junit {
+    for path in [&a.junit, &a.sarif].into_iter().flatten() {
         check_destination(path)?;
     }
     // The report is staged in a folder beside its destination: a stop waits for the next
@@ -358,7 +358,8 @@ fn audit(
         }
     }
     write_audit_junit(a.junit.as_deref(), &report, &rerun)?;
-    let out = summary(out, err, &[a.junit.as_deref()]);
+    write_audit_sarif(a.sarif.as_deref(), &report, &rerun)?;
+    let out = summary(out, err, &[a.junit.as_deref(), a.sarif.as_deref()]);
     emit(out, a.json, &report, gloffuse::report::audit::table::render)?;
     Ok(verdict(report.check_passed() || a.exit_zero))
 }
@@ -372,13 +373,22 @@ fn write_audit_junit(path: Option<&Path>, report: &AuditReport, rerun: &str) -> 
     Ok(())
 }
 
+fn write_audit_sarif(path: Option<&Path>, report: &AuditReport, rerun: &str) -> Result<()> {
+    if let Some(path) = path {
+        let log = gloffuse::report::audit::sarif::render(report, rerun);
+        write_output(path, format!("{log}\n").as_bytes())?;
+        eprintln_quietly(&format!("wrote {}", path.display()));
+    }
+    Ok(())
+}
+
 /// `report merge`: the shards read and checked, then the outputs of one unsharded audit.
 fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<Outcome> {
     use gloffuse::report::audit::merge::{Skipped, copy_pictures};
     if let Some(dir) = &m.report {
         gloffuse::report::check_dir(dir)?;
     }
-    for path in [&m.junit, &m.json].into_iter().flatten() {
+    for path in [&m.junit, &m.sarif, &m.json].into_iter().flatten() {
         check_destination(path)?;
     }
     // As in `audit`: a stop removes the staging folder instead of ending the process in it.
@@ -407,6 +417,7 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
         }
     }
     write_audit_junit(m.junit.as_deref(), report, &rerun)?;
+    write_audit_sarif(m.sarif.as_deref(), report, &rerun)?;
     if let Some(path) = &m.json {
         let text = serde_json::to_string_pretty(report).expect("reports serialise to JSON");
         write_output(path, format!("{text}\n").as_bytes())?;
@@ -414,7 +425,11 @@ fn merge(m: &args::MergeArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resul
             eprintln_quietly(&format!("wrote {}", path.display()));
         }
     }
-    let out = summary(out, err, &[m.junit.as_deref(), m.json.as_deref()]);
+    let out = summary(
+        out,
+        err,
+        &[m.junit.as_deref(), m.sarif.as_deref(), m.json.as_deref()],
+    );
     if !m.json.as_deref().is_some_and(is_stdout) {
         out.write_all(gloffuse::report::audit::table::render(report).as_bytes())?;
     }

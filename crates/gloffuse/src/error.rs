@@ -191,6 +191,8 @@ pub enum Field {
     AuditPath,
     /// An audit configuration file (`gloffuse.toml`).
     AuditConfig,
+    /// An earlier audit report to compare with.
+    Baseline,
     /// The only audit rules that run.
     Select,
     /// Audit rules that do not run.
@@ -270,6 +272,7 @@ impl Field {
             Field::AllowDowngrade => "permission to downgrade the file",
             Field::AuditPath => "path to audit",
             Field::AuditConfig => "audit configuration",
+            Field::Baseline => "baseline report",
             Field::Select => "rules to run",
             Field::Ignore => "rules to skip",
             Field::FailOn => "verdicts that fail",

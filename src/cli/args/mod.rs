@@ -171,6 +171,7 @@ pub fn flag(field: Field) -> String {
         Field::AllowDowngrade => "--allow-downgrade",
         Field::AuditPath => "PATH",
         Field::AuditConfig => "gloffuse.toml",
+        Field::Baseline => "--baseline",
         Field::Select => "--select",
         Field::Ignore => "--ignore",
         Field::FailOn => "--fail-on",

@@ -37,6 +37,10 @@ pub struct MergeArgs {
     #[arg(long, value_name = "FILE.xml")]
     pub junit: Option<PathBuf>,
 
+    /// Write the merged verdict as a SARIF 2.1.0 log.
+    #[arg(long, value_name = "FILE.sarif")]
+    pub sarif: Option<PathBuf>,
+
     /// Write report.html, report.json and the materials' pictures (copied from the shards'
     /// report folders) into this folder.
     #[arg(long, value_name = "DIR")]

@@ -7,7 +7,7 @@
 //! DIR/shard-K/       shard K's report (report.json, report.html, materials/)
 //! DIR/shard-K.xml    its JUnit
 //! DIR/merged/        the merged report, as one unsharded audit writes it
-//! DIR/merged.json    DIR/merged.xml
+//! DIR/merged.json    DIR/merged.xml    DIR/merged.sarif
 //! DIR/logs/          the Slurm jobs' output
 //! ```
 
@@ -60,6 +60,7 @@ impl FarmJob {
         args.extend([
             format!("--json={dir}/{MERGED}.json"),
             format!("--junit={dir}/{MERGED}.xml"),
+            format!("--sarif={dir}/{MERGED}.sarif"),
             format!("--report={dir}/{MERGED}"),
         ]);
         args

@@ -18,7 +18,7 @@ use crate::cli::{Outcome, Result, print_json};
 use jobs::{FarmJob, MERGED, SlurmJob, openjd, slurm};
 
 /// The flags the farm sets on every shard itself.
-const FARM_FLAGS: &str = "--shard, --report, --junit, --json or --exit-zero";
+const FARM_FLAGS: &str = "--shard, --report, --junit, --sarif, --json or --exit-zero";
 
 /// The job `a` describes, checked: the paths hold .blend files and the audit flags parse.
 fn job(a: &FarmArgs) -> Result<FarmJob> {
@@ -44,6 +44,7 @@ fn job(a: &FarmArgs) -> Result<FarmJob> {
             if audit.shard.is_some()
                 || audit.report.is_some()
                 || audit.junit.is_some()
+                || audit.sarif.is_some()
                 || audit.json
                 || audit.exit_zero
             {

@@ -184,6 +184,7 @@ pub fn judge_material(
         material: m.name.clone(),
         verdict,
         reason,
+        baseline: None,
         fails: Some(fails),
         suppressed,
         mean: own.map(|b| b.mean),

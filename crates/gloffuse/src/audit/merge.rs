@@ -145,6 +145,16 @@ pub fn merge(paths: &[PathBuf]) -> Result<Merged, Error> {
             sources.push((k, i));
         }
     }
+    // Each shard names the baseline's materials gone from its own files.
+    if let Some(summary) = &mut report.baseline {
+        summary.absent = ordered
+            .iter()
+            .filter_map(|(_, r)| r.baseline.as_ref())
+            .flat_map(|b| b.absent.iter().cloned())
+            .collect();
+        summary.absent.sort();
+        summary.absent.dedup();
+    }
     report.finish();
     Ok(Merged {
         report,
@@ -172,6 +182,14 @@ fn difference(first: &AuditReport, r: &AuditReport) -> Option<String> {
         return Some(format!(
             "its settings differ ({})",
             serde_json::to_string(&r.settings).unwrap_or_default()
+        ));
+    }
+    let baseline = |r: &AuditReport| r.baseline.as_ref().map(|b| b.path.clone());
+    if baseline(r) != baseline(first) {
+        return Some(format!(
+            "it was compared with another baseline ({}, the other {})",
+            baseline(r).unwrap_or_else(|| "none".into()),
+            baseline(first).unwrap_or_else(|| "none".into())
         ));
     }
     if b != a {

@@ -5,6 +5,7 @@
 //! path, `user_blend`), audited again. Files are streamed: each file's grid is handed to the
 //! caller and dropped before the next file starts.
 
+pub mod baseline;
 pub mod config;
 pub mod files;
 mod fix;
@@ -18,6 +19,7 @@ mod twins;
 pub mod verdict;
 pub mod waivers;
 
+pub use baseline::{Baseline, BaselineState, BaselineSummary};
 pub use verdict::{
     After, AuditJudging, AuditReport, AuditSettings, AuditedFile, AuditedMaterial, Counts, Finding,
     Fixed, ShardInput, ShardRun, Verdict, Waived,
@@ -77,6 +79,8 @@ pub struct AuditOptions {
     /// Whether the files' own `gloffuse_ignore` properties waive findings (as ruff's
     /// `--ignore-noqa` turned around: false disregards them; gloffuse.toml still counts).
     pub property_waivers: bool,
+    /// An earlier report: the check then fails only on what is new or worse than in it.
+    pub baseline: Option<PathBuf>,
 }
 
 impl Default for AuditOptions {
@@ -90,6 +94,7 @@ impl Default for AuditOptions {
             allow_downgrade: false,
             shard: None,
             blender: BlenderOptions::default(),
+            baseline: None,
             select: Vec::new(),
             ignore: Vec::new(),
             property_waivers: true,
@@ -127,10 +132,10 @@ pub fn audit(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    // Bad input (a bad gloffuse.toml too) fails before Blender is looked for.
-    let (files, mut configs) = checked_files(o)?;
-    let blender = find_for_files(&o.blender, &files, Field::AuditPath, None, progress)?;
-    audit_files(&blender, o, &files, &mut configs, progress, on_file)
+    // Bad input (a bad gloffuse.toml or baseline too) fails before Blender is looked for.
+    let mut inputs = checked_inputs(o)?;
+    let blender = find_for_files(&o.blender, &inputs.files, Field::AuditPath, None, progress)?;
+    audit_files(&blender, o, &mut inputs, progress, on_file)
 }
 
 /// [`audit`] with a Blender already found.
@@ -140,13 +145,19 @@ pub fn audit_with(
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
-    let (files, mut configs) = checked_files(o)?;
-    audit_files(blender, o, &files, &mut configs, progress, on_file)
+    let mut inputs = checked_inputs(o)?;
+    audit_files(blender, o, &mut inputs, progress, on_file)
 }
 
-/// The options checked, the files they name, and the configurations that hold them (each
-/// read and checked now).
-fn checked_files(o: &AuditOptions) -> Result<(Vec<PathBuf>, Configs), Error> {
+/// What the options name, each read and checked before any Blender runs.
+struct Inputs {
+    files: Vec<PathBuf>,
+    /// The configurations that hold the files.
+    configs: Configs,
+    baseline: Option<Baseline>,
+}
+
+fn checked_inputs(o: &AuditOptions) -> Result<Inputs, Error> {
     check(o)?;
     let files = files::blend_files(&o.paths)?;
     check_fix_targets(o, &files)?;
@@ -154,19 +165,24 @@ fn checked_files(o: &AuditOptions) -> Result<(Vec<PathBuf>, Configs), Error> {
     for file in &files {
         configs.for_file(file)?;
     }
-    Ok((files, configs))
+    let baseline = o.baseline.as_deref().map(Baseline::read).transpose()?;
+    Ok(Inputs {
+        files,
+        configs,
+        baseline,
+    })
 }
 
 fn audit_files(
     blender: &Blender,
     o: &AuditOptions,
-    files: &[PathBuf],
-    configs: &mut Configs,
+    inputs: &mut Inputs,
     progress: &dyn Progress,
     on_file: &mut dyn FnMut(FileDone) -> Result<(), Error>,
 ) -> Result<AuditReport, Error> {
     let mut report = empty_report(o, blender);
-    let (files, counts) = files_to_audit(o, files, &mut report);
+    let (files, counts) = files_to_audit(o, &inputs.files, &mut report);
+    let configs = &mut inputs.configs;
     let fix_targets = fix_targets(o, &files, blender);
     let mut twins = TwinGroups::new(blender);
     let mut predictor = Predictor::new(blender.version);
@@ -229,6 +245,9 @@ fn audit_files(
         progress.set(done);
     }
     progress.end();
+    if let Some(baseline) = &inputs.baseline {
+        baseline.apply(&mut report);
+    }
     report.finish();
     Ok(report)
 }
@@ -302,6 +321,7 @@ fn empty_report(o: &AuditOptions, blender: &Blender) -> AuditReport {
         gloffuse_version: env!("CARGO_PKG_VERSION").to_string(),
         blender_version: blender.version_string.clone(),
         blender_program: blender.program.display().to_string(),
+        baseline: None,
         settings: AuditSettings {
             cell: o.settings.cell,
             samples: o.settings.samples,
@@ -497,6 +517,7 @@ fn judged(
     policy.file_findings(&mut findings);
     let entry = AuditedFile {
         file: name,
+        error_in_baseline: false,
         saved_by: read_header(file)
             .ok()
             .and_then(|h| h.version)
@@ -526,6 +547,7 @@ fn failed_file(file: &Path, e: &Error, blender: BlenderVersion) -> AuditedFile {
         file: file.display().to_string(),
         saved_by: saved_by.map(|v| v.to_string()),
         error: Some(error),
+        error_in_baseline: false,
         findings: Vec::new(),
         materials: 0,
         log: None,

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::baseline::{BaselineState, BaselineSummary};
 use super::fix_choice::MaterialFix;
 use super::rules::{Effect, Severity};
 use crate::shard::Shard;
@@ -149,6 +150,10 @@ pub struct AuditedMaterial {
     /// Why a verdict in `fail_on` does not fail: its findings waived or below `error`.
     #[serde(default)]
     pub suppressed: Option<String>,
+    /// With `--baseline`: new, worse, better or unchanged beside the baseline's material of
+    /// that file and name (a failing material fails the check only when new or worse).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<BaselineState>,
     pub mean: Option<f64>,
     pub center: Option<f64>,
     pub rim: Option<f64>,
@@ -177,9 +182,14 @@ pub struct AuditedMaterial {
 }
 
 impl AuditedMaterial {
-    /// Whether it fails the check.
+    /// Whether it fails the check: it fails, and is new or worse beside a baseline.
     pub fn failing(&self) -> bool {
-        self.fails == Some(true)
+        self.fails == Some(true) && self.beyond_baseline()
+    }
+
+    /// Whether a failure of it counts beside the baseline (without one, always).
+    pub fn beyond_baseline(&self) -> bool {
+        self.baseline.is_none_or(BaselineState::counts)
     }
 }
 
@@ -201,6 +211,10 @@ pub struct AuditedFile {
     pub saved_by: Option<String>,
     /// Why the file could not be audited (its materials are then missing from the report).
     pub error: Option<String>,
+    /// With `--baseline`: the baseline has an error for this file too, so its error does
+    /// not fail the check.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub error_in_baseline: bool,
     /// Findings of the file as a whole (its scenes' settings).
     pub findings: Vec<Finding>,
     pub materials: usize,
@@ -269,6 +283,10 @@ pub struct AuditReport {
     /// Set in a shard's report (`--shard K/N`): which part it is, and the whole run's inputs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<ShardRun>,
+    /// With `--baseline`: the baseline, and how many materials are new, worse, better and
+    /// unchanged beside it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<BaselineSummary>,
     /// Whether the files as they were pass the check.
     pub passed: bool,
     /// With a fix: whether what is left after it passes (the exit code's verdict).
@@ -296,7 +314,8 @@ pub struct ShardInput {
 }
 
 impl AuditReport {
-    /// Counts the verdicts and decides `passed` (no file error, no verdict in `fail_on`).
+    /// Counts the verdicts and decides `passed`: no file error (none the baseline has
+    /// too), no failing material (new or worse beside a baseline).
     pub fn finish(&mut self) {
         let mut counts = Counts {
             files: self.files.len(),
@@ -333,8 +352,11 @@ impl AuditReport {
             .chain(self.files.iter().flat_map(|f| &f.findings))
             .filter(|f| f.waived.is_some())
             .count();
-        let file_failed = (counts.files_failed > 0
-            && self.settings.fail_on.contains(&Verdict::Error))
+        let new_file_error = self
+            .files
+            .iter()
+            .any(|f| f.error.is_some() && !f.error_in_baseline);
+        let file_failed = (new_file_error && self.settings.fail_on.contains(&Verdict::Error))
             || self
                 .files
                 .iter()
@@ -346,11 +368,23 @@ impl AuditReport {
         self.passed_after_fix = self.settings.fix.then(|| {
             !file_failed
                 && !self.materials.iter().any(|m| {
-                    m.after
-                        .as_ref()
-                        .map_or(m.failing(), |a| a.fails == Some(true))
+                    m.after.as_ref().map_or(m.failing(), |a| {
+                        a.fails == Some(true) && m.beyond_baseline()
+                    })
                 })
         });
+        if let Some(summary) = &mut self.baseline {
+            let n = |state| {
+                self.materials
+                    .iter()
+                    .filter(|m| m.baseline == Some(state))
+                    .count()
+            };
+            summary.new = n(BaselineState::New);
+            summary.worse = n(BaselineState::Worse);
+            summary.better = n(BaselineState::Better);
+            summary.unchanged = n(BaselineState::Unchanged);
+        }
         self.counts = counts;
     }
 

@@ -7,7 +7,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::table::{counts, file_findings, older_blender, order, pct};
+use super::table::{baseline_words, counts, file_findings, older_blender, order, pct};
 use crate::audit::waivers::said;
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Finding, Verdict};
 use crate::plural::count;
@@ -161,6 +161,12 @@ fn card(index: usize, m: &AuditedMaterial, picture: Option<String>) -> String {
         s.push_str(&format!(
             "<p class=\"suppressed\">Suppressed: {}</p>\n",
             escape(why)
+        ));
+    }
+    if let Some(state) = m.baseline {
+        s.push_str(&format!(
+            "<p class=\"baseline\">{}.</p>\n",
+            escape(&capitalised(&baseline_words(m, state)))
         ));
     }
     if let Some(why) = &m.no_fix {
@@ -370,8 +376,23 @@ fn once_each(findings: &[Finding]) -> Vec<(&Finding, Vec<&str>)> {
     let mut kept: Vec<(&Finding, Vec<&str>)> = Vec::new();
     for f in findings {
         let same = |k: &Finding| {
-            (&k.rule, &k.why, &k.fix, &k.twin, &k.versions, &k.waived, k.severity)
-                == (&f.rule, &f.why, &f.fix, &f.twin, &f.versions, &f.waived, f.severity)
+            (
+                &k.rule,
+                &k.why,
+                &k.fix,
+                &k.twin,
+                &k.versions,
+                &k.waived,
+                k.severity,
+            ) == (
+                &f.rule,
+                &f.why,
+                &f.fix,
+                &f.twin,
+                &f.versions,
+                &f.waived,
+                f.severity,
+            )
         };
         match kept.iter_mut().find(|(k, _)| same(k)) {
             Some((_, nodes)) if nodes.contains(&f.node.as_str()) => {}
@@ -437,6 +458,69 @@ fn shorten_path(text: &str, file: &str) -> String {
             .join(&quote.to_string());
     }
     out
+}
+
+/// A finding's waiver (or its severity below error), in words for the page.
+fn waived_words(f: &Finding) -> String {
+    match &f.waived {
+        Some(w) => format!(" <b>Waived:</b> {}.", escape(&said(w))),
+        None if f.severity != crate::audit::rules::Severity::Error => {
+            format!(" <b>Severity:</b> {}.", f.severity.key())
+        }
+        None => String::new(),
+    }
+}
+
+/// The banner's words on what does not fail: suppressed materials, waived findings, and the
+/// files as they were when a fix changed the verdict.
+fn suppressed_words(report: &AuditReport) -> String {
+    let c = &report.counts;
+    let mut s = String::new();
+    if c.suppressed > 0 {
+        s.push_str(&format!(
+            " {} not failing (waived, or below error severity).",
+            count(c.suppressed, "material", "materials")
+        ));
+    }
+    if c.waived_findings > 0 {
+        s.push_str(&format!(
+            " {} waived.",
+            count(c.waived_findings, "finding", "findings")
+        ));
+    }
+    if let Some(b) = &report.baseline {
+        s.push_str(&format!(
+            " Beside the baseline {}: {} new, {} worse, {} better, {} unchanged{}.",
+            escape(&b.path),
+            b.new,
+            b.worse,
+            b.better,
+            b.unchanged,
+            match b.absent.len() {
+                0 => String::new(),
+                n => format!(", {} gone", count(n, "material", "materials")),
+            }
+        ));
+    }
+    if report
+        .passed_after_fix
+        .is_some_and(|after| after != report.passed)
+    {
+        s.push_str(&format!(
+            " Before the fix: {}.",
+            if report.passed { "PASS" } else { "FAIL" }
+        ));
+    }
+    s
+}
+
+/// `text` with its first letter in capitals.
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(first) => first.to_uppercase().chain(chars).collect(),
+        None => String::new(),
+    }
 }
 
 #[cfg(test)]
@@ -648,44 +732,4 @@ mod tests {
         assert!(page.contains("<b>in/a.blend</b> fixed as out/a.blend (1 lobe replaced)."));
         assert!(page.contains("<code>filter-glossy</code> in 1 file: fg."));
     }
-}
-
-/// A finding's waiver (or its severity below error), in words for the page.
-fn waived_words(f: &Finding) -> String {
-    match &f.waived {
-        Some(w) => format!(" <b>Waived:</b> {}.", escape(&said(w))),
-        None if f.severity != crate::audit::rules::Severity::Error => {
-            format!(" <b>Severity:</b> {}.", f.severity.key())
-        }
-        None => String::new(),
-    }
-}
-
-/// The banner's words on what does not fail: suppressed materials, waived findings, and the
-/// files as they were when a fix changed the verdict.
-fn suppressed_words(report: &AuditReport) -> String {
-    let c = &report.counts;
-    let mut s = String::new();
-    if c.suppressed > 0 {
-        s.push_str(&format!(
-            " {} not failing (waived, or below error severity).",
-            count(c.suppressed, "material", "materials")
-        ));
-    }
-    if c.waived_findings > 0 {
-        s.push_str(&format!(
-            " {} waived.",
-            count(c.waived_findings, "finding", "findings")
-        ));
-    }
-    if report
-        .passed_after_fix
-        .is_some_and(|after| after != report.passed)
-    {
-        s.push_str(&format!(
-            " Before the fix: {}.",
-            if report.passed { "PASS" } else { "FAIL" }
-        ));
-    }
-    s
 }

@@ -68,6 +68,15 @@ fn case(m: &AuditedMaterial, rerun: &str) -> TestCase {
         let mut status = TestCaseStatus::skipped();
         status.set_message(xml_attribute(why));
         status
+    } else if m.fails == Some(true) {
+        // A failure the baseline has: skipped, as a suppressed one is.
+        let mut status = TestCaseStatus::skipped();
+        status.set_message(xml_attribute(&format!(
+            "{}: {} (in the baseline)",
+            m.verdict.key(),
+            m.reason
+        )));
+        status
     } else {
         TestCaseStatus::success()
     };
@@ -81,6 +90,9 @@ fn case(m: &AuditedMaterial, rerun: &str) -> TestCase {
     }
     case.set_classname(xml_attribute(&m.file));
     case.add_property(Property::new("verdict", m.verdict.key()));
+    if let Some(state) = m.baseline {
+        case.add_property(Property::new("baseline", state.key()));
+    }
     for (name, value) in [("mean", m.mean), ("rim", m.rim), ("twin_mean", m.twin_mean)] {
         if let Some(v) = value {
             case.add_property(Property::new(name, format!("{v:.4}")));

@@ -1,11 +1,12 @@
-//! Renderers of the audit's verdict: `table` (terminal), `junit` (CI servers), `html` (a
-//! page for people, each material as authored beside its twin and their difference), and
-//! the report folder, whose pictures are made file by file while the audit streams, or
-//! copied from the shards' folders by `merge`.
+//! Renderers of the audit's verdict: `table` (terminal), `junit` (CI servers), `sarif`
+//! (code-scanning services), `html` (a page for people, each material as authored beside
+//! its twin and their difference), and the report folder, whose pictures are made file by
+//! file while the audit streams, or copied from the shards' folders by `merge`.
 
 pub mod html;
 pub mod junit;
 pub mod merge;
+pub mod sarif;
 pub mod table;
 
 use std::path::{Path, PathBuf};

@@ -5,7 +5,7 @@
 
 use crate::audit::rules::Severity;
 use crate::audit::waivers::said;
-use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Verdict};
+use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, BaselineState, Verdict};
 use crate::plural::count;
 use crate::report::escape::terminal;
 
@@ -56,6 +56,12 @@ pub fn render(report: &AuditReport) -> String {
             terminal(why)
         ));
     }
+    s.push_str(&last_line(report));
+    s
+}
+
+/// The verdict, the counts, what does not fail and why, beside a baseline and before a fix.
+fn last_line(report: &AuditReport) -> String {
     let failing: Vec<&str> = report.settings.fail_on.iter().map(|v| v.key()).collect();
     let unread = match report.counts.files_failed {
         0 => String::new(),
@@ -74,6 +80,20 @@ pub fn render(report: &AuditReport) -> String {
             count(report.counts.waived_findings, "finding", "findings")
         ));
     }
+    if let Some(b) = &report.baseline {
+        notes.push_str(&format!(
+            "; beside the baseline {}: {} new, {} worse, {} better, {} unchanged{}",
+            terminal(&b.path),
+            b.new,
+            b.worse,
+            b.better,
+            b.unchanged,
+            match b.absent.len() {
+                0 => String::new(),
+                n => format!(", {} gone", count(n, "material", "materials")),
+            }
+        ));
+    }
     // With a fix, the verdict is the exit code's: what is left after the fix.
     let fix = match report.passed_after_fix {
         Some(after) if after != report.passed => format!(
@@ -82,7 +102,7 @@ pub fn render(report: &AuditReport) -> String {
         ),
         _ => String::new(),
     };
-    s.push_str(&format!(
+    format!(
         "\n{}: {}{unread}{notes} (failing on: {}){fix}\n",
         if report.check_passed() {
             "PASS"
@@ -91,8 +111,7 @@ pub fn render(report: &AuditReport) -> String {
         },
         counts(report).map(|(_, words)| words).join(", "),
         failing.join(", ")
-    ));
-    s
+    )
 }
 
 /// A material's line, then its reason, what suppresses it, its waived findings and its fix.
@@ -119,6 +138,9 @@ fn material_lines(m: &AuditedMaterial) -> String {
     if let Some(why) = &m.suppressed {
         s.push_str(&format!("{:<36}suppressed: {}\n", "", terminal(why)));
     }
+    if let Some(state) = m.baseline {
+        s.push_str(&format!("{:<36}{}\n", "", baseline_words(m, state)));
+    }
     // Each waiver once: those the suppression already names are not repeated.
     let named = m.suppressed.as_deref().unwrap_or_default();
     for f in &m.findings {
@@ -144,6 +166,18 @@ fn material_lines(m: &AuditedMaterial) -> String {
         ));
     }
     s
+}
+
+/// A material beside the baseline, in words: its state, and whether its failure counts.
+pub(super) fn baseline_words(m: &AuditedMaterial, state: BaselineState) -> String {
+    let counted = if m.fails != Some(true) {
+        ""
+    } else if state.counts() {
+        " (it fails the check)"
+    } else {
+        " (its failure is in the baseline: it does not fail the check)"
+    };
+    format!("{} beside the baseline{counted}", state.key())
 }
 
 /// A finding's rule as the table lists it: marked when it is waived or not an error.
