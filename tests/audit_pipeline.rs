@@ -16,6 +16,7 @@ use std::process::Command;
 use serde_json::{Value, json};
 
 use common::audit_json as audit;
+use common::audit_material as material;
 
 /// Writes `out` in `blender` with one material per entry of `materials`.
 fn make_file(blender: &Path, out: &Path, materials: Value) {
@@ -44,16 +45,6 @@ fn diffuse(name: &str) -> Value {
     json!({"name": name, "shader": "diffuse", "roughness": 0.0, "ignore": null})
 }
 
-/// The report's material `name`.
-fn material<'a>(report: &'a Value, name: &str) -> &'a Value {
-    report["materials"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|m| m["material"] == name)
-        .unwrap_or_else(|| panic!("no material {name} in {report}"))
-}
-
 /// Each material's baseline state, by name.
 fn states(report: &Value) -> Vec<(String, String)> {
     let mut states: Vec<(String, String)> = report["materials"]
@@ -73,6 +64,21 @@ fn states(report: &Value) -> Vec<(String, String)> {
 
 fn os(s: &str) -> &OsStr {
     s.as_ref()
+}
+
+/// `audit --no-render --baseline BASELINE --sarif SARIF FILE`.
+fn against(blender: &Path, baseline: &Path, sarif: &Path, file: &Path) -> (i32, Value, String) {
+    audit(
+        blender,
+        &[
+            os("--no-render"),
+            os("--baseline"),
+            baseline.as_os_str(),
+            os("--sarif"),
+            sarif.as_os_str(),
+            file.as_os_str(),
+        ],
+    )
 }
 
 fn baseline_and_sarif(label: &'static str, blender: PathBuf) {
@@ -95,17 +101,7 @@ fn baseline_and_sarif(label: &'static str, blender: PathBuf) {
 
     // The same file against it: everything unchanged, so the check passes.
     let sarif = dir.path().join("same.sarif");
-    let (code, same, stderr) = audit(
-        &blender,
-        &[
-            os("--no-render"),
-            os("--baseline"),
-            baseline.as_os_str(),
-            os("--sarif"),
-            sarif.as_os_str(),
-            library.as_os_str(),
-        ],
-    );
+    let (code, same, stderr) = against(&blender, &baseline, &sarif, &library);
     assert_eq!(code, 0, "{label}: {stderr}");
     assert!(
         states(&same).iter().all(|(_, s)| s == "unchanged"),
@@ -128,17 +124,7 @@ fn baseline_and_sarif(label: &'static str, blender: PathBuf) {
     ];
     make_file(&blender, &library, json!(second));
     let sarif = dir.path().join("next.sarif");
-    let (code, next, stderr) = audit(
-        &blender,
-        &[
-            os("--no-render"),
-            os("--baseline"),
-            baseline.as_os_str(),
-            os("--sarif"),
-            sarif.as_os_str(),
-            library.as_os_str(),
-        ],
-    );
+    let (code, next, stderr) = against(&blender, &baseline, &sarif, &library);
     assert_eq!(code, 1, "{label}: new and worse materials fail: {stderr}");
     assert_eq!(
         states(&next),

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use common::audit_json as audit;
+use common::audit_material as material;
 
 /// The configuration beside the files: it waives one material by name.
 const CONFIG: &str = "# the studio's audit configuration\n\n[[waiver]]\nrules = \
@@ -29,16 +30,6 @@ fn make_files(blender: &Path, dir: &Path) {
         "{made:?}"
     );
     std::fs::write(dir.join("gloffuse.toml"), CONFIG).unwrap();
-}
-
-/// The report's material `name`.
-fn material<'a>(report: &'a Value, name: &str) -> &'a Value {
-    report["materials"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|m| m["material"] == name)
-        .unwrap_or_else(|| panic!("no material {name} in {report}"))
 }
 
 /// The findings of `m` of rule `rule`.

@@ -63,6 +63,16 @@ pub fn audit_json(
     )
 }
 
+/// The material `name` of an audit's JSON report (panics, naming it, if there is none).
+pub fn audit_material<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    report["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["material"] == name)
+        .unwrap_or_else(|| panic!("no material {name} in {report}"))
+}
+
 /// A headless browser for the report page: `$GLOFFUSE_TEST_CHROMIUM`, else Debian's
 /// `/usr/bin/chromium` (which `scripts/test.sh` installs). A missing one fails the test
 /// unless `GLOFFUSE_SKIP_BROWSER_TESTS=1` ([`skip`]).

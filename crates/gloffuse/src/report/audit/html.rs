@@ -7,7 +7,9 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::table::{baseline_words, counts, file_findings, older_blender, order, pct};
+use super::table::{
+    baseline_counts, baseline_words, counts, file_findings, older_blender, order, pct,
+};
 use crate::audit::waivers::said;
 use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, Finding, Verdict};
 use crate::plural::count;
@@ -490,16 +492,8 @@ fn suppressed_words(report: &AuditReport) -> String {
     }
     if let Some(b) = &report.baseline {
         s.push_str(&format!(
-            " Beside the baseline {}: {} new, {} worse, {} better, {} unchanged{}.",
-            escape(&b.path),
-            b.new,
-            b.worse,
-            b.better,
-            b.unchanged,
-            match b.absent.len() {
-                0 => String::new(),
-                n => format!(", {} gone", count(n, "material", "materials")),
-            }
+            " {}.",
+            escape(&capitalised(&baseline_counts(b, &b.path)))
         ));
     }
     if report

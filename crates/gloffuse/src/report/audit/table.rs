@@ -5,7 +5,9 @@
 
 use crate::audit::rules::Severity;
 use crate::audit::waivers::said;
-use crate::audit::{AuditReport, AuditedFile, AuditedMaterial, BaselineState, Verdict};
+use crate::audit::{
+    AuditReport, AuditedFile, AuditedMaterial, BaselineState, BaselineSummary, Verdict,
+};
 use crate::plural::count;
 use crate::report::escape::terminal;
 
@@ -81,18 +83,7 @@ fn last_line(report: &AuditReport) -> String {
         ));
     }
     if let Some(b) = &report.baseline {
-        notes.push_str(&format!(
-            "; beside the baseline {}: {} new, {} worse, {} better, {} unchanged{}",
-            terminal(&b.path),
-            b.new,
-            b.worse,
-            b.better,
-            b.unchanged,
-            match b.absent.len() {
-                0 => String::new(),
-                n => format!(", {} gone", count(n, "material", "materials")),
-            }
-        ));
+        notes.push_str(&format!("; {}", baseline_counts(b, &terminal(&b.path))));
     }
     // With a fix, the verdict is the exit code's: what is left after the fix.
     let fix = match report.passed_after_fix {
@@ -166,6 +157,18 @@ fn material_lines(m: &AuditedMaterial) -> String {
         ));
     }
     s
+}
+
+/// The materials beside the baseline (`path` as the renderer shows it), in words.
+pub(super) fn baseline_counts(b: &BaselineSummary, path: &str) -> String {
+    let gone = match b.absent.len() {
+        0 => String::new(),
+        n => format!(", {} gone", count(n, "material", "materials")),
+    };
+    format!(
+        "beside the baseline {path}: {} new, {} worse, {} better, {} unchanged{gone}",
+        b.new, b.worse, b.better, b.unchanged
+    )
 }
 
 /// A material beside the baseline, in words: its state, and whether its failure counts.
