@@ -647,14 +647,7 @@ fn verify_help_spells_each_modes_defaults_as_its_spec_holds_them() {
     use gloffuse::measure::Engine;
     use gloffuse::verify::modes::{EngineDefaults, SecondAxis, spec};
 
-    let out = gloffuse()
-        .args(["verify", "--help"])
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let help = String::from_utf8(out).unwrap();
+    let help = help_of(&["verify"]);
     type Value = fn(&EngineDefaults) -> String;
     let numbers: [(&str, Value); 3] = [
         ("--spp", |d| d.samples.to_string()),
@@ -768,16 +761,8 @@ fn lut_refresh_and_audit_help_spell_the_librarys_defaults() {
     use gloffuse::refresh::measure_samples;
 
     let size = option_help(&help_of(&["lut"]), "--size");
-    let kinds = [
-        Kind::SplitSum,
-        Kind::KullaConty,
-        Kind::Albedo,
-        Kind::Coat,
-        Kind::Anisotropic,
-        Kind::Glass,
-    ];
     let most = Kind::Albedo.facts().default_size;
-    for kind in kinds {
+    for kind in Kind::ALL {
         let facts = kind.facts();
         if facts.default_size != most {
             let named = format!("{} for {}", facts.default_size, facts.key);

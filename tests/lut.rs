@@ -71,14 +71,7 @@ fn assert_same_texels(found: &[f32], table: &Table, bits: Bits, what: &str) {
     }
 }
 
-const KINDS: [Kind; 6] = [
-    Kind::SplitSum,
-    Kind::KullaConty,
-    Kind::Albedo,
-    Kind::Coat,
-    Kind::Anisotropic,
-    Kind::Glass,
-];
+const KINDS: [Kind; 6] = Kind::ALL;
 const BITS: [Bits; 2] = [Bits::Half, Bits::Float];
 
 #[test]

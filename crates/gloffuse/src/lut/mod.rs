@@ -72,6 +72,15 @@ pub enum Kind {
 }
 
 impl Kind {
+    pub const ALL: [Kind; 6] = [
+        Kind::SplitSum,
+        Kind::KullaConty,
+        Kind::Albedo,
+        Kind::Coat,
+        Kind::Anisotropic,
+        Kind::Glass,
+    ];
+
     /// Everything this kind's module says of it: the one registration of a kind.
     pub fn facts(self) -> &'static KindFacts {
         match self {
