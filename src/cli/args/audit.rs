@@ -70,7 +70,8 @@ pub struct AuditArgs {
     #[arg(long, value_parser = parse_tolerance, default_value_t = 100.0 * AuditJudging::default().tolerance)]
     pub tolerance: f64,
 
-    /// Allowed brightness above 100 % of any view-cosine ring, in percent.
+    /// Allowed brightness above 100 % of any view-cosine ring, in percent (plus three
+    /// standard errors of that ring's render noise).
     #[arg(long, value_parser = parse_tolerance, default_value_t = 100.0 * AuditJudging::default().ring_tolerance)]
     pub ring_tolerance: f64,
 

@@ -126,6 +126,7 @@ mod tests {
             center: mean,
             rim: mean,
             max_ring: mean,
+            ring_floor: mean,
             standard_error: 0.001,
             opacity: 1.0,
         }

@@ -75,12 +75,17 @@ impl Grid<'_> {
         if s.opacity.is_nan() || s.opacity < MIN_OPACITY || !s.mean.is_finite() {
             return None;
         }
-        let rings = s.rings.iter().map(|r| r.mean).filter(|m| m.is_finite());
+        let rings = s.rings.iter().filter(|r| r.mean.is_finite());
+        let floors = rings
+            .clone()
+            .filter(|r| r.standard_error.is_finite())
+            .map(|r| r.mean - NOISE_SIGMAS * r.standard_error);
         Some(Brightness {
             mean: s.seen(),
             center: s.center,
             rim: s.rim,
-            max_ring: rings.fold(f64::NEG_INFINITY, f64::max),
+            max_ring: rings.map(|r| r.mean).fold(f64::NEG_INFINITY, f64::max),
+            ring_floor: floors.fold(f64::NEG_INFINITY, f64::max),
             standard_error: s.standard_error,
             opacity: s.opacity,
         })
@@ -257,10 +262,10 @@ fn by_rules(findings: &[Finding], judging: &AuditJudging) -> (Verdict, String) {
 }
 
 /// Whether a sphere renders above 100 % by more than the tolerance and its noise, or has a
-/// ring above 100 % by more than the ring tolerance.
+/// ring above 100 % by more than the ring tolerance and that ring's noise.
 pub fn creates(b: &Brightness, j: &AuditJudging) -> bool {
     b.mean > 1.0 + j.tolerance + NOISE_SIGMAS * b.standard_error
-        || b.max_ring > 1.0 + j.ring_tolerance
+        || b.ring_floor > 1.0 + j.ring_tolerance
 }
 
 fn by_furnace(
@@ -355,6 +360,55 @@ fn why_unknown(f: &Finding) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 64 px cell holding a white sphere whose pixels with view cosine in [0.4, 0.5)
+    /// (the audit's outermost ring of fully covered pixels at this size) read `rim(x, y)`;
+    /// the world around it is 1 too.
+    fn sphere(rim: impl Fn(usize, usize) -> f32) -> Rgba {
+        let (cell, radius) = (64usize, 0.9 * 32.0);
+        let pixels = (0..cell * cell)
+            .map(|i| {
+                let (x, y) = (i % cell, i / cell);
+                let d = ((x as f64 + 0.5 - 32.0).hypot(y as f64 + 0.5 - 32.0)) / radius;
+                let mu = (1.0 - d * d).max(0.0).sqrt();
+                let v = if d < 1.0 && (0.4..0.5).contains(&mu) {
+                    rim(x, y)
+                } else {
+                    1.0
+                };
+                [v, v, v, 1.0]
+            })
+            .collect();
+        Rgba {
+            width: cell,
+            height: cell,
+            pixels,
+        }
+    }
+
+    /// A grazing ring brighter than 100 % by more than the ring tolerance creates energy;
+    /// one that reads so only by its noise (a few pixels far apart) does not.
+    #[test]
+    fn a_ring_creates_only_beyond_its_noise() {
+        let j = AuditJudging::default();
+        let judge = |image: &Rgba| {
+            let grid = Grid {
+                image,
+                columns: 1,
+                cell: 64,
+                radius_fraction: 0.9,
+            };
+            grid.brightness(0).unwrap()
+        };
+        let bright = judge(&sphere(|_, _| 1.06));
+        assert!(bright.max_ring > 1.05 && creates(&bright, &j), "{bright:?}");
+        let noisy = judge(&sphere(|x, y| if (x + y) % 2 == 0 { 0.7 } else { 1.42 }));
+        assert!(
+            noisy.max_ring > 1.03,
+            "the noisy ring reads bright: {noisy:?}"
+        );
+        assert!(!creates(&noisy, &j), "{noisy:?}");
+    }
 
     /// A job whose grid its image does not hold is the file's error.
     #[test]

@@ -113,6 +113,11 @@ pub struct Brightness {
     pub rim: f64,
     /// The brightest ring.
     pub max_ring: f64,
+    /// The highest of the rings' means less their noise (three standard errors each): a
+    /// ring of a few grazing pixels can read above 100 % by noise alone at the audit's
+    /// samples, and must not count as creating energy.
+    #[serde(default)]
+    pub ring_floor: f64,
     pub standard_error: f64,
     /// How much of the disc the material covers (1: opaque).
     pub opacity: f64,
