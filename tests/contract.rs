@@ -15,7 +15,7 @@ use std::process::Command;
 use gloffuse::audit::job::{FixItem, document};
 use gloffuse::bench::audit::library_document;
 use gloffuse::generate::Mode;
-use gloffuse::measure::{Distribution, Engine, Roughness};
+use gloffuse::measure::{BlenderVersion, Distribution, Engine, Roughness};
 use gloffuse::verify::{Plan, RenderSettings};
 
 #[test]
@@ -42,11 +42,18 @@ fn the_python_validators_accept_the_real_documents_and_refuse_bad_ones() {
         ),
         (
             "audit_document",
-            serde_json::to_value(document(None, None, exr, exr, &[])),
+            serde_json::to_value(document(BlenderVersion::OLDEST, None, None, exr, exr, &[])),
         ),
         (
             "audit_document+groups",
-            serde_json::to_value(document(Some(&generate), Some(render), exr, exr, &fix)),
+            serde_json::to_value(document(
+                BlenderVersion::NEWEST_KNOWN,
+                Some(&generate),
+                Some(render),
+                exr,
+                exr,
+                &fix,
+            )),
         ),
         (
             "bench_library_document",

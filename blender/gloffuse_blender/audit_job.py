@@ -26,7 +26,15 @@ import time
 
 import bpy
 
-from .audit_rules import applicable_rules, scan_material, scan_scenes, twin_groups, uv_maps_named
+from .audit_rules import (
+    MULTISCATTER_TWIN,
+    TWIN_KINDS,
+    applicable_rules,
+    scan_material,
+    scan_scenes,
+    twin_groups,
+    uv_maps_named,
+)
 from .audit_twin import (
     apply_finding,
     datablock_pointers,
@@ -155,11 +163,17 @@ def material_waivers(material):
 
 
 def group_needs(entries, groups):
-    """The (mode, distribution) of every gloffuse group a twin uses, sorted."""
-    by_name = {name: (mode, distribution) for mode, names in groups.items()
-               for distribution, name in names.items()}
+    """The (mode, distribution) of every gloffuse group a twin uses, sorted
+    (Blender's own Multiscatter GGX is no group)."""
+    by_name = {name: (TWIN_KINDS[kind], distribution) for kind, names in groups.items()
+               for distribution, name in names.items() if name != MULTISCATTER_TWIN}
     return sorted({by_name[name] for entry in entries for item in entry["findings"]
                    for name in (item["twin"], item.get("metal_twin")) if name in by_name})
+
+
+# The generate document's group fields that twins use, and the mode of each.
+TWIN_GROUP_FIELDS = (("layered_group", "layered"), ("anisotropic_group", "anisotropic"),
+                     ("glass_group", "glass"), ("refraction_group", "glass"))
 
 
 def provided_groups(document):
@@ -169,8 +183,9 @@ def provided_groups(document):
     for spec in document.get("groups") or []:
         if (spec.get("view") or {}).get("multiscatter_group"):
             provided.add(("multiscatter", spec["distribution"]))
-        if spec.get("layered_group"):
-            provided.add(("layered", spec["distribution"]))
+        for field, mode in TWIN_GROUP_FIELDS:
+            if spec.get(field):
+                provided.add((mode, spec["distribution"]))
     return provided
 
 

@@ -34,6 +34,10 @@ MULTISCATTER_TWIN = "Multiscatter GGX"
 CLAMP_TWIN = "clamped to 1"
 TOON_TWIN = "Smooth 0"
 ADD_TWIN = "itself (a fix scales the Add Shader to 100 % by its brightness)"
+# The kinds of lobe a twin replaces (the audit section's twin_names), and the
+# generate mode whose groups each kind's twins are.
+TWIN_KINDS = {"multiscatter": "multiscatter", "layered": "layered", "anisotropic": "anisotropic",
+              "glass": "glass", "refraction": "glass"}
 
 # Nodes that carry no reflecting closure (add-reflecting), and the colour
 # inputs that may exceed 1 (light, not albedo: color-above-one).
@@ -55,11 +59,13 @@ def applicable_rules(rules):
 
 
 def twin_groups(audit):
-    """{"multiscatter": {distribution: group name}, "layered": {...}}: the
-    gloffuse groups a twin may use, as the audit section names them (built only
-    when a job asks for them, see audit_job.py's group_needs)."""
+    """{kind of lobe: {distribution: twin}}: the twin of each kind of lobe the
+    audit replaces, as the audit section names them: a gloffuse group (built
+    only when a job asks for it, see audit_job.py's group_needs), or
+    MULTISCATTER_TWIN where Blender's own Multiscatter GGX keeps the light. A
+    distribution missing has no conserving twin in this Blender."""
     names = audit.get("twin_names") or {}
-    return {mode: dict(names.get(mode) or {}) for mode in ("multiscatter", "layered")}
+    return {kind: dict(names.get(kind) or {}) for kind in TWIN_KINDS}
 
 
 def is_own_group(tree):
@@ -178,6 +184,12 @@ def multiscatter_twin(distribution, groups):
     return groups["multiscatter"].get(distribution)
 
 
+def anisotropic(node):
+    """An anisotropic lobe: its Anisotropy linked or not 0 (3.x's Anisotropic
+    BSDF, 4.0+'s Glossy BSDF)."""
+    return "Anisotropy" in node.inputs and constant(node.inputs["Anisotropy"]) != 0.0
+
+
 def glossy_detail(node, roughness):
     detail = {"distribution": node.distribution, "roughness": roughness,
               "color": constant(node.inputs["Color"])}
@@ -192,22 +204,24 @@ def rule_glossy_single_scatter(node, groups):
     matters, roughness = rough(node)
     if not matters:
         return []
-    return [finding("glossy-single-scatter", node, glossy_detail(node, roughness),
-                    multiscatter_twin(node.distribution, groups))]
+    if anisotropic(node):
+        twin = groups["anisotropic"].get(node.distribution)
+    else:
+        twin = multiscatter_twin(node.distribution, groups)
+    return [finding("glossy-single-scatter", node, glossy_detail(node, roughness), twin)]
 
 
 def rule_anisotropic_multiscatter(node, groups):
     if node.bl_idname not in GLOSSY_TYPES or node.distribution != "MULTI_GGX" \
-            or "Anisotropy" not in node.inputs:
+            or not anisotropic(node):
         return []
-    anisotropy = constant(node.inputs["Anisotropy"])
-    if anisotropy == 0.0:
-        return []
-    return [finding("anisotropic-multiscatter", node, glossy_detail(node, constant(node.inputs["Roughness"])))]
+    return [finding("anisotropic-multiscatter", node, glossy_detail(node, constant(node.inputs["Roughness"])),
+                    groups["anisotropic"].get("GGX"))]
 
 
-def rule_microfacet_single_scatter(rule, idname, twin):
-    """The GGX/Beckmann rules of Metallic, Glass and Refraction BSDF."""
+def rule_microfacet_single_scatter(rule, idname, twin_kind=None):
+    """The GGX/Beckmann rules of Metallic, Glass and Refraction BSDF; their twin
+    Multiscatter GGX, or the twins of `twin_kind`."""
     def rule_function(node, groups):
         if node.bl_idname != idname or node.distribution not in ("GGX", "BECKMANN"):
             return []
@@ -217,6 +231,7 @@ def rule_microfacet_single_scatter(rule, idname, twin):
         detail = {"distribution": node.distribution, "roughness": roughness}
         if "IOR" in node.inputs:
             detail["ior"] = constant(node.inputs["IOR"])
+        twin = MULTISCATTER_TWIN if twin_kind is None else groups[twin_kind].get(node.distribution)
         return [finding(rule, node, detail, twin)]
     return rule_function
 
@@ -239,8 +254,22 @@ def principled_ior(node):
     return round((1.0 + root) / (1.0 - root), 6)
 
 
+def thin_glass_only(node):
+    """A Principled BSDF all of whose light goes to its thin-glass lobes (5.2's
+    Thin Wall on, Transmission 1, Metallic 0): Cycles compensates those under
+    any distribution (bsdf_thin_glass_setup preserves energy whatever the node
+    asks), and the lobes that lose under GGX (metal, specular over the base)
+    then carry no weight."""
+    wall = principled_input(node, "thin_wall")
+    if wall is None or source(wall) is not None or not wall.default_value:
+        return False
+    return constant(principled_input(node, "transmission")) == 1.0 \
+        and constant(node.inputs["Metallic"]) == 0.0
+
+
 def rule_principled_single_scatter(node, groups):
-    if node.bl_idname != "ShaderNodeBsdfPrincipled" or node.distribution != "GGX":
+    if node.bl_idname != "ShaderNodeBsdfPrincipled" or node.distribution != "GGX" \
+            or thin_glass_only(node):
         return []
     return [finding("principled-single-scatter", node, principled_detail(node), MULTISCATTER_TWIN)]
 
@@ -604,9 +633,9 @@ def rule_unknown_node(node, groups):
 NODE_RULES = (
     rule_glossy_single_scatter,
     rule_anisotropic_multiscatter,
-    rule_microfacet_single_scatter("metallic-single-scatter", "ShaderNodeBsdfMetallic", MULTISCATTER_TWIN),
-    rule_microfacet_single_scatter("glass-single-scatter", "ShaderNodeBsdfGlass", MULTISCATTER_TWIN),
-    rule_microfacet_single_scatter("refraction-single-scatter", "ShaderNodeBsdfRefraction", None),
+    rule_microfacet_single_scatter("metallic-single-scatter", "ShaderNodeBsdfMetallic"),
+    rule_microfacet_single_scatter("glass-single-scatter", "ShaderNodeBsdfGlass", "glass"),
+    rule_microfacet_single_scatter("refraction-single-scatter", "ShaderNodeBsdfRefraction", "refraction"),
     rule_principled_creates_energy,  # before single-scatter: its twin replaces the node
     rule_principled_single_scatter,
     rule_mix_fresnel_layering,

@@ -1,10 +1,12 @@
 # ---------------------------------------------------------------------------
 # gloffuse audit_twin.py: what `gloffuse audit` puts in place of a flagged
 # node. One finding's replacement applied to a node tree: Multiscatter GGX on
-# the node itself, a gloffuse group node in its place (inputs copied, outputs
+# the node itself, a gloffuse group node in its place (the Multiscatter,
+# Layered, Anisotropic, Glass or Refraction group: inputs copied, outputs
 # relinked), an Add Shader that creates energy scaled back to 100 % (only in a
 # fix, by the scale Rust measured: a twin is rendered before it is known), a
-# colour clamped to 1, a Toon's Smooth set to 0. The twin of a material is its copy with every replacement
+# colour clamped to 1, a Toon's Smooth set to 0. The twin of a material is its
+# copy with every replacement
 # applied, and its own copies of the group trees on the way to a flagged node
 # (so no other material changes); --fix applies the same replacements to the
 # real trees in place.
@@ -90,12 +92,15 @@ def to_multiscatter(tree, node, item):
     return True
 
 
-def glossy_twin(tree, node, item):
+def twin_in_place(tree, node, item):
+    """The node set to Multiscatter GGX, or the twin group in its place fed
+    as the node was, input by input of the same name (Color, Roughness,
+    Anisotropy, Rotation, IOR, Normal, Tangent: the groups take the node's own
+    inputs, an unlinked Tangent meaning the node's default tangent too)."""
     if item["twin"] == MULTISCATTER_TWIN:
         return to_multiscatter(tree, node, item)
-    return group_in_place(tree, node, item["twin"], {
-        "Color": node.inputs["Color"], "Roughness": node.inputs["Roughness"],
-        "Normal": node.inputs["Normal"]})
+    inputs = {sock.name: sock for sock in node.inputs if sock.enabled}
+    return group_in_place(tree, node, item["twin"], inputs)
 
 
 def principled_layered_twin(tree, node, item):
@@ -179,9 +184,11 @@ def toon_sharp(tree, node, item):
 
 
 REPLACEMENTS = {
-    "glossy-single-scatter": glossy_twin,
+    "glossy-single-scatter": twin_in_place,
+    "anisotropic-multiscatter": twin_in_place,
     "metallic-single-scatter": to_multiscatter,
-    "glass-single-scatter": to_multiscatter,
+    "glass-single-scatter": twin_in_place,
+    "refraction-single-scatter": twin_in_place,
     "principled-single-scatter": to_multiscatter,
     "principled-creates-energy": principled_layered_twin,
     "mix-fresnel-layering": mix_layered_twin,

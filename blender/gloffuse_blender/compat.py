@@ -449,6 +449,7 @@ _PRINCIPLED_INPUTS = {
     "subsurface": ("Subsurface Weight", "Subsurface"),
     "emission_color": ("Emission Color", "Emission"),
     "specular": ("Specular",),  # 3.x only: F0 = 0.08 x Specular (4.0+ takes IOR)
+    "thin_wall": ("Thin Wall",),  # 5.2 on
 }
 
 

@@ -83,7 +83,8 @@ CONTRACT = {
         }
     },
     "rule_range": {"required": {"id": "", "from": "", "before": ""}},
-    "twin_names": {"required": {"multiscatter": "", "layered": ""}},
+    "twin_names": {"required": {"multiscatter": "", "layered": "", "anisotropic": "", "glass": "",
+                                "refraction": ""}},
     "fix_item": {"required": {"material": "", "scale": ""}},
     "bench_library_document": {"required": {"bench_library": "bench_library"}},
     "bench_library": {"required": {"output": "", "count": "", "first": ""}},

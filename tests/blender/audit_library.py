@@ -236,15 +236,15 @@ def rules_file(path):
 
         m, n, out = lib.material("anisotropic-ggx-r1", "loses",
                                  "3.x's Anisotropic BSDF, single-scatter GGX r=1, anisotropy 0.5: keeps "
-                                 "~50 % (furnace 0.50), its Multiscatter GGX twin ~100 %")
+                                 "~50 % (furnace 0.50), its Gloffuse Anisotropic (GGX) twin ~100 %")
         surface(m, out, glossy(n, "Anisotropic BSDF", "GGX", 1.0, anisotropy=0.5,
                                idname="ShaderNodeBsdfAnisotropic").outputs[0])
         lib.expect(m, "glossy-single-scatter", "Anisotropic BSDF")
 
     # Multiscatter GGX with anisotropy: 3.x's Multiscatter GGX is a random walk that handles
     # anisotropy (no rule); from 4.0 Cycles compensates it with the isotropic albedo table
-    # (the rule fires). 4.5 and 5.0 render it at 0.905 (r=0.5, anisotropy 0.5): it loses, and
-    # with no conserving twin to compare against, a losing rule alone makes the verdict loses.
+    # (the rule fires). 4.5 and 5.0 render it at 0.905 (r=0.5, anisotropy 0.5): it loses
+    # beside its Gloffuse Anisotropic (GGX) twin.
     name = "anisotropic-multi-ggx-a05"
     if pre4:
         m, n, out = lib.material(name, "ok", "3.x's random-walk Multiscatter GGX conserves energy "
@@ -253,8 +253,8 @@ def rules_file(path):
                                idname="ShaderNodeBsdfAnisotropic").outputs[0])
     else:
         m, n, out = lib.material(name, "loses", "4.x compensates anisotropic Multiscatter GGX with "
-                                                "the isotropic table: furnace 0.905, a loss no "
-                                                "Blender node restores (no twin: the rule decides)")
+                                                "the isotropic table: furnace 0.905, a loss "
+                                                "its Gloffuse Anisotropic twin restores")
         surface(m, out, glossy(n, "Glossy BSDF", "MULTI_GGX", 0.5, anisotropy=0.5).outputs[0])
         lib.expect(m, "anisotropic-multiscatter", "Glossy BSDF")
 
@@ -299,8 +299,8 @@ def rules_file(path):
         fires = roughness > 0
         m, n, out = lib.material(
             "refraction-ggx-%s" % label, "loses" if fires else "ok",
-            "rough single-scatter refraction loses light (furnace 0.994) and has no conserving "
-            "twin: the losing rule decides" if fires else
+            "rough single-scatter refraction loses light; its Gloffuse Refraction (GGX) twin "
+            "restores it" if fires else
             "smooth refraction (r=0): no rule; never above 100 %")
         refraction = n.new("ShaderNodeBsdfRefraction")
         refraction.name = "Refraction BSDF"

@@ -219,7 +219,7 @@ mod tests {
     use crate::bench::audit::library_document;
     use crate::fit::Coefficients;
     use crate::generate::{ColorModel, Curves, GenerateParams, Mode};
-    use crate::measure::{Distribution, Engine, Masking, Roughness};
+    use crate::measure::{BlenderVersion, Distribution, Engine, Masking, Roughness};
     use crate::verify::{Plan, RenderSettings};
 
     fn seed() -> GenerateParams {
@@ -286,8 +286,14 @@ mod tests {
             scale: Some(0.5),
         }];
         let exr = Path::new("audit.exr");
-        for (groups, render) in [(None, None), (Some(&generate[0]), Some(render))] {
-            let audit = document(groups, render, exr, exr, &fix);
+        let oldest = BlenderVersion::OLDEST;
+        let newest = BlenderVersion::NEWEST_KNOWN;
+        let cases = [
+            (oldest, None, None),
+            (newest, Some(&generate[0]), Some(render)),
+        ];
+        for (version, groups, render) in cases {
+            let audit = document(version, groups, render, exr, exr, &fix);
             checker
                 .check(&to_value(audit), "audit_document", "audit document")
                 .unwrap();

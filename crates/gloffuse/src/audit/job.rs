@@ -4,7 +4,6 @@
 //! twin on the same sphere in the white furnace; asked to fix, it applies the replacements
 //! of the materials it is given, saves the copy and audits the copy instead.
 
-use std::collections::BTreeMap;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -12,10 +11,11 @@ use std::time::Duration;
 use serde::{Deserialize, Serialize};
 
 use super::rules::{RuleRange, ranges};
+use super::twins::TwinNames;
 use crate::Error;
 use crate::blender::{Blender, BlenderOptions, Run, run_following_render, runs};
-use crate::generate::{GenerateParams, Job, assemble, layered_group_name, multiscatter_group_name};
-use crate::measure::{Distribution, Engine};
+use crate::generate::{GenerateParams, Job, assemble};
+use crate::measure::BlenderVersion;
 use crate::output::write_output;
 use crate::verify::RenderSettings;
 
@@ -45,27 +45,6 @@ struct AuditSection {
 pub struct FixItem {
     pub material: usize,
     pub scale: Option<f64>,
-}
-
-#[derive(Clone, Debug, Serialize)]
-struct TwinNames {
-    multiscatter: BTreeMap<&'static str, String>,
-    layered: BTreeMap<&'static str, String>,
-}
-
-impl TwinNames {
-    fn new() -> Self {
-        let by = |name: fn(Distribution) -> String| {
-            Distribution::ALL
-                .into_iter()
-                .map(|d| (d.blender_enum(), name(d)))
-                .collect()
-        };
-        TwinNames {
-            multiscatter: by(|d| multiscatter_group_name(Engine::Cycles, d)),
-            layered: by(layered_group_name),
-        }
-    }
 }
 
 /// The job's parameter document: the generate fields (the groups twins may need), flattened,
@@ -214,7 +193,14 @@ pub fn run_job(s: &JobSettings, file: &Path, fix: Option<FixOutput>) -> Result<J
     let exr = run_dir.join("audit.exr");
     let twin_exr = run_dir.join("audit-twins.exr");
     let materials = fix.as_ref().map_or(&[][..], |f| f.materials);
-    let mut params = document(s.groups, s.render, &exr, &twin_exr, materials);
+    let mut params = document(
+        s.blender.version,
+        s.groups,
+        s.render,
+        &exr,
+        &twin_exr,
+        materials,
+    );
     params
         .audit
         .rules
@@ -252,6 +238,7 @@ pub fn run_job(s: &JobSettings, file: &Path, fix: Option<FixOutput>) -> Result<J
 /// The job's parameter document: the groups twins may use (when they were asked for), the
 /// render settings (none: scan only), where the two renders go, and the materials to fix.
 pub fn document<'a>(
+    version: BlenderVersion,
     groups: Option<&'a GenerateParams>,
     render: Option<RenderSettings>,
     exr: &Path,
@@ -269,7 +256,7 @@ pub fn document<'a>(
         threads: 0,
         radius_fraction: settings.radius_fraction,
         rules: ranges(),
-        twin_names: TwinNames::new(),
+        twin_names: TwinNames::new(version),
         fix: fix.to_vec(),
     };
     AuditParams {

@@ -97,7 +97,8 @@ pub const RULES: &[Rule] = &[
         why: "a single-scatter glossy lobe (GGX, Beckmann or Ashikhmin–Shirley) loses the light \
               that bounces between microfacets, and Cycles compensates only Multiscatter GGX",
         fix: "use Multiscatter GGX (GGX), or the gloffuse Multiscatter group of the same \
-              distribution (Beckmann, Ashikhmin–Shirley)",
+              distribution (Beckmann, Ashikhmin–Shirley); an anisotropic lobe: the gloffuse \
+              Anisotropic group",
     },
     Rule {
         id: "anisotropic-multiscatter",
@@ -110,7 +111,8 @@ pub const RULES: &[Rule] = &[
         why: "Cycles compensates an anisotropic Multiscatter GGX lobe with the isotropic table \
               at the geometric-mean roughness, which misses most of its loss (73 % at \
               anisotropy 0.8, roughness 0.7)",
-        fix: "keep the anisotropy low where brightness matters; no node in Blender restores it",
+        fix: "use the gloffuse Anisotropic (GGX) group, which restores the light of every view \
+              and keeps the highlight's shape",
     },
     Rule {
         id: "metallic-single-scatter",
@@ -129,7 +131,9 @@ pub const RULES: &[Rule] = &[
         before: None,
         why: "single-scatter rough glass loses light at every interface (22 % at roughness 0.5, \
               66 % at 1, IOR 1.5)",
-        fix: "set the Glass BSDF's distribution to Multiscatter GGX",
+        fix: "use the gloffuse Glass group of the same distribution (before 3.6 GGX glass: \
+              Multiscatter GGX, which keeps the light there); Multiscatter GGX glass from 3.6 \
+              still loses at grazing views",
     },
     Rule {
         id: "refraction-single-scatter",
@@ -139,7 +143,8 @@ pub const RULES: &[Rule] = &[
         before: None,
         why: "the Refraction BSDF has no multiscatter option in any Blender: rough refraction \
               loses light",
-        fix: "use a Glass BSDF with Multiscatter GGX where the look allows",
+        fix: "use the gloffuse Refraction group of the same distribution: it refracts as the \
+              node does and returns all the light meeting it, entering and leaving",
     },
     Rule {
         id: "principled-single-scatter",
