@@ -8,12 +8,20 @@ asset catalogs. Enabling it copies them into the extension's user directory
 and registers that directory as the asset library "Gloffuse"; disabling it
 removes the library again. The groups then show in the Asset Browser and, in
 the shader editor, under Add > Shader.
+
+It also brings the audit into Blender (panel_ui.py): a "Gloffuse" panel in
+Properties > Material and a "Gloffuse" tab in the Shader Editor's sidebar, and
+the operators gloffuse.audit_material, gloffuse.audit_file and
+gloffuse.fix_material. The gloffuse binary bundles the modules this one imports
+into the extension's __init__.py, beside the catalogue they read.
 """
 import filecmp
 import os
 import shutil
 
 import bpy
+
+from .panel_ui import register_panel, unregister_panel
 
 LIBRARY_NAME = "Gloffuse"
 BUNDLED = os.path.join(os.path.dirname(__file__), "library")
@@ -44,6 +52,7 @@ def _registered(directory):
 
 
 def register():
+    register_panel(os.path.dirname(__file__))
     directory = _user_library()
     if _registered(directory) is None:
         # Blender's default import method for a new library (Append (Reuse Data)
@@ -54,6 +63,7 @@ def register():
 
 
 def unregister():
+    unregister_panel()
     directory = bpy.utils.extension_path_user(__package__, path="library", create=False)
     library = _registered(directory)
     if library is not None:

@@ -428,6 +428,29 @@ def compat_eevee_furnace(scene, world, samples):
         eevee.use_bloom = False
 
 
+# Inputs a newer Blender adds to a node it loads from an older file, at a value that
+# renders as before: (input identifier, that value, inputs that only matter when it
+# differs). 5.0 gives the Glass BSDF a thin film of thickness 0 (none).
+_ADDED_INPUTS = (
+    ("Thin Film Thickness", 0.0, ("Thin Film IOR",)),
+)
+
+
+def inputs_added_as_before(node):
+    """Identifiers of `node`'s unlinked inputs that a newer Blender may have added
+    when it loaded the file and that change nothing (_ADDED_INPUTS): a group
+    gloffuse built in 4.5 renders the same in 5.0, so its fingerprint leaves
+    them out."""
+    unlinked = {sock.identifier: sock for sock in node.inputs if not sock.is_linked}
+    left_out = set()
+    for identifier, neutral, dependents in _ADDED_INPUTS:
+        sock = unlinked.get(identifier)
+        if sock is not None and getattr(sock, "default_value", None) == neutral:
+            left_out.add(identifier)
+            left_out.update(name for name in dependents if name in unlinked)
+    return left_out
+
+
 # --- audit (audit_rules.py, audit_twin.py, audit_job.py) ---------------------------
 
 def version_in_range(first, before):

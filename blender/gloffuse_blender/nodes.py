@@ -16,6 +16,7 @@ from .compat import (
     blender_version_string,
     clear_interface,
     existing_signature_subtype,
+    inputs_added_as_before,
     interface_has_panels,
     interface_sockets,
     multiply_color_node,
@@ -160,15 +161,17 @@ def _rna_value(value):
 
 def _node_content(node, stack):
     """What a node renders with: its type, mute, its own settings (every
-    writable property a plain node lacks), its unlinked inputs' values, and a
-    nested group's content or an image's name."""
+    writable property a plain node lacks), its unlinked inputs' values (but
+    those a newer Blender adds at a value that changes nothing), and a nested
+    group's content or an image's name."""
     base = {prop.identifier for prop in bpy.types.Node.bl_rna.properties}
     settings = {prop.identifier: _rna_value(getattr(node, prop.identifier))
                 for prop in node.bl_rna.properties
                 if prop.identifier not in base and not prop.is_readonly
                 and prop.type in ("BOOLEAN", "INT", "FLOAT", "STRING", "ENUM")}
+    added = inputs_added_as_before(node)
     inputs = [[sock.identifier, _rna_value(getattr(sock, "default_value", None))]
-              for sock in node.inputs if not sock.is_linked]
+              for sock in node.inputs if not sock.is_linked and sock.identifier not in added]
     tree = getattr(node, "node_tree", None)
     image = getattr(node, "image", None)
     return [node.name, node.bl_idname, bool(node.mute), settings, inputs,

@@ -97,6 +97,7 @@ impl GenerateArgs {
             allow_downgrade: self.allow_downgrade,
             force: self.force,
             extension: self.extension.clone(),
+            audit_catalogue: Some(gloffuse::audit::catalogue::EXTENSION),
             modes: self.mode.clone(),
             engines: self.engine.clone(),
             color_model: self.color_model,

@@ -6,6 +6,7 @@
 //! caller and dropped before the next file starts.
 
 pub mod baseline;
+pub mod catalogue;
 pub mod config;
 pub mod files;
 mod fix;

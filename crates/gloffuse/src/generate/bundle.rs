@@ -95,6 +95,14 @@ pub const MODULES: &[(&str, &str)] = &[
         include_str!("../../../../blender/gloffuse_blender/normal_group.py"),
     ),
     (
+        "panel_ui",
+        include_str!("../../../../blender/gloffuse_blender/panel_ui.py"),
+    ),
+    (
+        "panel_verdict",
+        include_str!("../../../../blender/gloffuse_blender/panel_verdict.py"),
+    ),
+    (
         "params",
         include_str!("../../../../blender/gloffuse_blender/params.py"),
     ),
@@ -536,8 +544,8 @@ pub fn concatenate(parts: &[Part]) -> String {
     s
 }
 
-/// The extension's `__init__.py`: `addon.py` as it is when it imports no other module,
-/// else bundled with what it imports.
+/// The extension's `__init__.py`: `addon.py` bundled with what it imports (the panel and
+/// the audit's own rules and fixes), or as it is when it imports nothing.
 pub fn addon() -> String {
     let parts = bundle("addon").expect("the embedded add-on bundles");
     match parts.as_slice() {
@@ -674,10 +682,20 @@ mod tests {
     }
 
     #[test]
-    fn the_addon_ships_as_it_is() {
-        assert_eq!(
-            addon(),
-            MODULES.iter().find(|(n, _)| *n == "addon").unwrap().1
-        );
+    fn the_addon_bundles_the_audits_own_rules_and_fixes() {
+        let parts = bundle("addon").unwrap();
+        let labels = labels(&parts);
+        for module in [
+            "audit_rules.py",
+            "audit_twin.py",
+            "panel_verdict.py",
+            "panel_ui.py",
+        ] {
+            assert!(labels.contains(&module), "{module} in {labels:?}");
+        }
+        assert_eq!(labels.last(), Some(&"addon.py"));
+        let text = addon();
+        assert!(text.contains("def scan_material(") && text.contains("def apply_finding("));
+        assert!(!text.contains("from ."), "package imports resolved");
     }
 }

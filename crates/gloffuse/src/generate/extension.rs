@@ -1,8 +1,13 @@
 //! The Blender extension (4.2+): a .zip Blender installs from disk, holding
 //! `blender_manifest.toml`, a small add-on (GPL-3.0-or-later) that registers the bundled
 //! library as an asset library when enabled and removes it when disabled, and the library
-//! itself (the .blend of CC0 node groups and its catalog file).
+//! itself (the .blend of CC0 node groups and its catalog file). The add-on also holds the
+//! audit's panel and operators (issue 42), which read the rule catalogue and the
+//! integrator's predictions from the file an [`AuditCatalogue`] writes: the audit is a later
+//! stage than generate, so its caller (the CLI) hands it in
+//! (`gloffuse::audit::catalogue::EXTENSION`).
 
+use std::fmt;
 use std::io::{Cursor, Write};
 
 use zip::write::SimpleFileOptions;
@@ -23,6 +28,26 @@ pub const LIBRARY_FOLDER: &str = "library";
 pub const LIBRARY_FILE: &str = "gloffuse.blend";
 
 const LICENSE: &str = include_str!("../../../../LICENSE");
+
+/// Writes the audit's data for the extension's panel, for the Blender that builds it.
+#[derive(Clone, Copy)]
+pub struct AuditCatalogue {
+    /// Its name inside the extension.
+    pub file_name: &'static str,
+    pub write: fn(BlenderVersion) -> String,
+}
+
+impl fmt::Debug for AuditCatalogue {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "AuditCatalogue({})", self.file_name)
+    }
+}
+
+impl PartialEq for AuditCatalogue {
+    fn eq(&self, other: &Self) -> bool {
+        self.file_name == other.file_name && std::ptr::fn_addr_eq(self.write, other.write)
+    }
+}
 
 /// The manifest. `blender_version_min` is the Blender that saved the library: an older one
 /// may not read the file (5.0's .blend format is new) or its node sockets.
@@ -75,13 +100,20 @@ pub fn can_build(built_with: BlenderVersion) -> Result<(), Error> {
 }
 
 /// The extension's .zip, from the library .blend and its catalog file, built by Blender
-/// `built_with` (4.2 or later). Entries are stored with a fixed date, so the same inputs
-/// give the same bytes.
-pub fn package(blend: &[u8], catalogs: &str, built_with: BlenderVersion) -> Result<Vec<u8>, Error> {
+/// `built_with` (4.2 or later), with the audit's data when `audit` is given (without it the
+/// panel says it has none). Entries are stored with a fixed date, so the same inputs give
+/// the same bytes.
+pub fn package(
+    blend: &[u8],
+    catalogs: &str,
+    built_with: BlenderVersion,
+    audit: Option<AuditCatalogue>,
+) -> Result<Vec<u8>, Error> {
     can_build(built_with)?;
     let manifest = manifest(built_with);
     let addon = super::bundle::addon();
-    let files: [(String, &[u8]); 5] = [
+    let audit = audit.map(|a| (a.file_name.to_string(), (a.write)(built_with)));
+    let mut files: Vec<(String, &[u8])> = vec![
         ("blender_manifest.toml".into(), manifest.as_bytes()),
         ("__init__.py".into(), addon.as_bytes()),
         ("LICENSE".into(), LICENSE.as_bytes()),
@@ -91,6 +123,9 @@ pub fn package(blend: &[u8], catalogs: &str, built_with: BlenderVersion) -> Resu
             catalogs.as_bytes(),
         ),
     ];
+    if let Some((name, text)) = &audit {
+        files.push((name.clone(), text.as_bytes()));
+    }
     let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
     let options = SimpleFileOptions::default()
         .compression_method(CompressionMethod::Deflated)
@@ -115,8 +150,15 @@ mod tests {
     #[test]
     fn the_archive_holds_the_manifest_addon_and_library() {
         let v45 = BlenderVersion { major: 4, minor: 5 };
-        let bytes = package(b"BLENDER-fake", "VERSION 1\n", v45).unwrap();
-        assert_eq!(bytes, package(b"BLENDER-fake", "VERSION 1\n", v45).unwrap());
+        let audit = AuditCatalogue {
+            file_name: "audit.json",
+            write: |v| format!("{{\"blender\": [{}, {}]}}", v.major, v.minor),
+        };
+        let bytes = package(b"BLENDER-fake", "VERSION 1\n", v45, Some(audit)).unwrap();
+        assert_eq!(
+            bytes,
+            package(b"BLENDER-fake", "VERSION 1\n", v45, Some(audit)).unwrap()
+        );
         let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
         let mut names: Vec<String> = archive
             .file_names()
@@ -128,6 +170,7 @@ mod tests {
             [
                 "LICENSE",
                 "__init__.py",
+                "audit.json",
                 "blender_manifest.toml",
                 "library/blender_assets.cats.txt",
                 "library/gloffuse.blend"
@@ -147,11 +190,18 @@ mod tests {
             .read_to_end(&mut blend)
             .unwrap();
         assert_eq!(blend, b"BLENDER-fake");
+        let mut audit = String::new();
+        archive
+            .by_name("audit.json")
+            .unwrap()
+            .read_to_string(&mut audit)
+            .unwrap();
+        assert_eq!(audit, "{\"blender\": [4, 5]}");
     }
 
     #[test]
     fn blender_before_4_2_cannot_build_one() {
-        let err = package(b"", "", BlenderVersion { major: 3, minor: 4 }).unwrap_err();
+        let err = package(b"", "", BlenderVersion { major: 3, minor: 4 }, None).unwrap_err();
         assert!(err.to_string().contains("4.2 or later"), "{err}");
     }
 }

@@ -57,6 +57,9 @@ pub struct GenerateOptions {
     pub force: bool,
     /// Write a Blender extension (.zip) that installs the library as an asset library.
     pub extension: Option<PathBuf>,
+    /// The audit's data the extension's panel reads (the audit is a later stage: the
+    /// caller hands in `gloffuse::audit::catalogue::EXTENSION`); none: its panel has none.
+    pub audit_catalogue: Option<extension::AuditCatalogue>,
     /// Which groups to build besides the roughness-only pair.
     pub modes: Vec<Mode>,
     /// The engines to build groups for (empty: Cycles, or the engine of `coefficients`).
@@ -75,6 +78,7 @@ impl Default for GenerateOptions {
             allow_downgrade: false,
             force: false,
             extension: None,
+            audit_catalogue: None,
             modes: vec![Mode::Roughness],
             engines: Vec::new(),
             color_model: ColorModel::Exact,
@@ -617,6 +621,7 @@ fn package_extension(
         &blend,
         &catalogs,
         blender.version,
+        g.audit_catalogue,
     )?))
 }
 

@@ -1,0 +1,228 @@
+//! The audit as data for the Blender extension's panel (issue 42): the rule catalogue
+//! (ids, effects, severities, version ranges, why and fix), the names of the twins' groups,
+//! the tolerance of the verdict without a render, and the integrator's predictions on a grid.
+//! `gloffuse generate --extension` writes it into the extension as [`FILE_NAME`] (through
+//! [`EXTENSION`], which the CLI hands to generate, an earlier stage); the
+//! panel's Python (`blender/gloffuse_blender/panel_verdict.py`) only looks values up in it,
+//! so the words and numbers the panel shows are the ones `gloffuse audit --no-render` gives.
+//!
+//! The predictions are [`Predictor::predict`]'s own values at the grid's points: the panel
+//! interpolates linearly in roughness (and IOR for the hand-made layering), the one part of
+//! the prediction it computes. [`MAX_INTERPOLATION_ERROR`] bounds that interpolation, checked
+//! below against the predictor between the grid's points.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::rules::{Predictor, RULES};
+use super::twins::TwinNames;
+use super::verdict::AuditJudging;
+use crate::generate::extension::AuditCatalogue;
+use crate::measure::{BlenderVersion, Distribution};
+
+/// The file's name inside the extension.
+pub const FILE_NAME: &str = "audit_catalogue.json";
+
+/// Roughness 0..1 in this many steps (0.02 apart).
+pub const ROUGHNESS_STEPS: usize = 50;
+
+/// The IORs of the layering table: 1..3 (the range the predictor models) in this many steps.
+pub const IOR_STEPS: usize = 10;
+const IOR_RANGE: (f64, f64) = (1.0, 3.0);
+
+/// How far the panel's interpolated prediction may be from the predictor's (1.0 = 100 %).
+pub const MAX_INTERPOLATION_ERROR: f64 = 5e-4;
+
+#[derive(Clone, Debug, Serialize)]
+struct CatalogueRule {
+    id: &'static str,
+    effect: &'static str,
+    severity: &'static str,
+    from: [u32; 2],
+    before: Option<[u32; 2]>,
+    why: &'static str,
+    fix: &'static str,
+}
+
+/// The predictor's values on the grid, by Blender distribution enum.
+#[derive(Clone, Debug, Serialize)]
+pub struct Predictions {
+    /// The Blender these are for (the masking depends on it).
+    pub blender: [u32; 2],
+    pub roughness: Vec<f64>,
+    pub ior: Vec<f64>,
+    /// `glossy-single-scatter`: a white lobe's E_avg at each roughness.
+    pub glossy: BTreeMap<&'static str, Vec<f64>>,
+    /// `mix-fresnel-layering`: the hand-made mix's mean over a white base, by roughness
+    /// (outer) and IOR (inner).
+    pub layering: BTreeMap<&'static str, Vec<Vec<f64>>>,
+}
+
+/// Everything the panel reads.
+#[derive(Clone, Debug, Serialize)]
+pub struct Catalogue {
+    /// The gloffuse that wrote it.
+    pub gloffuse: &'static str,
+    /// The verdict's tolerance without a render (`gloffuse audit`'s default; a
+    /// gloffuse.toml may set another for the command line).
+    pub tolerance: f64,
+    rules: Vec<CatalogueRule>,
+    twin_names: TwinNames,
+    pub predictions: Predictions,
+}
+
+fn grid(from: f64, to: f64, steps: usize) -> Vec<f64> {
+    (0..=steps)
+        .map(|i| from + (to - from) * i as f64 / steps as f64)
+        .collect()
+}
+
+/// The predictions for Blender `version`.
+pub fn predictions(version: BlenderVersion) -> Predictions {
+    let mut predictor = Predictor::new(version);
+    let roughness = grid(0.0, 1.0, ROUGHNESS_STEPS);
+    let ior = grid(IOR_RANGE.0, IOR_RANGE.1, IOR_STEPS);
+    let mut glossy = BTreeMap::new();
+    let mut layering = BTreeMap::new();
+    for d in Distribution::ALL {
+        let name = d.blender_enum();
+        let mut at = |rule: &str, detail: serde_json::Value| {
+            predictor.predict(rule, &detail).unwrap_or(f64::NAN)
+        };
+        let row: Vec<f64> = roughness
+            .iter()
+            .map(|&r| {
+                at(
+                    "glossy-single-scatter",
+                    serde_json::json!({"distribution": name, "roughness": r}),
+                )
+            })
+            .collect();
+        glossy.insert(name, row);
+        let table: Vec<Vec<f64>> = roughness
+            .iter()
+            .map(|&r| {
+                ior.iter()
+                    .map(|&n| {
+                        at(
+                            "mix-fresnel-layering",
+                            serde_json::json!({"distribution": name, "roughness": r, "ior": n}),
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        layering.insert(name, table);
+    }
+    Predictions {
+        blender: [version.major, version.minor],
+        roughness,
+        ior,
+        glossy,
+        layering,
+    }
+}
+
+/// The catalogue for Blender `version`.
+pub fn catalogue(version: BlenderVersion) -> Catalogue {
+    Catalogue {
+        gloffuse: env!("CARGO_PKG_VERSION"),
+        tolerance: AuditJudging::default().tolerance,
+        rules: RULES
+            .iter()
+            .map(|r| CatalogueRule {
+                id: r.id,
+                effect: r.effect.key(),
+                severity: r.severity.key(),
+                from: [r.from.major, r.from.minor],
+                before: r.before.map(|b| [b.major, b.minor]),
+                why: r.why,
+                fix: r.fix,
+            })
+            .collect(),
+        twin_names: TwinNames::new(version),
+        predictions: predictions(version),
+    }
+}
+
+/// The catalogue as the extension carries it.
+pub fn to_json(version: BlenderVersion) -> String {
+    serde_json::to_string(&catalogue(version)).expect("the catalogue serialises")
+}
+
+/// What `gloffuse generate --extension` writes into the extension (generate is an earlier
+/// stage than the audit: the CLI hands this in through `GenerateOptions::audit_catalogue`).
+pub const EXTENSION: AuditCatalogue = AuditCatalogue {
+    file_name: FILE_NAME,
+    write: to_json,
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Linear interpolation of `values` on the evenly spaced `points` at `x` (a second
+    /// computation of what panel_verdict.py does).
+    fn lerp(points: &[f64], values: &[f64], x: f64) -> f64 {
+        let steps = points.len() - 1;
+        let at = (x - points[0]) / (points[steps] - points[0]) * steps as f64;
+        let i = (at.floor() as usize).min(steps - 1);
+        let t = at - i as f64;
+        values[i] * (1.0 - t) + values[i + 1] * t
+    }
+
+    #[test]
+    fn the_grid_interpolates_the_predictor_within_the_bound() {
+        let v45 = BlenderVersion { major: 4, minor: 5 };
+        let table = predictions(v45);
+        let mut predictor = Predictor::new(v45);
+        let mut worst: f64 = 0.0;
+        for d in Distribution::ALL {
+            let name = d.blender_enum();
+            for r in [0.003, 0.017, 0.055, 0.125, 0.333, 0.505, 0.777, 0.995] {
+                let want = predictor
+                    .predict(
+                        "glossy-single-scatter",
+                        &serde_json::json!({"distribution": name, "roughness": r}),
+                    )
+                    .unwrap();
+                let got = lerp(&table.roughness, &table.glossy[name], r);
+                worst = worst.max((got - want).abs());
+                let n = 1.45;
+                let want = predictor
+                    .predict(
+                        "mix-fresnel-layering",
+                        &serde_json::json!({"distribution": name, "roughness": r, "ior": n}),
+                    )
+                    .unwrap();
+                let rows: Vec<f64> = table.layering[name]
+                    .iter()
+                    .map(|row| lerp(&table.ior, row, n))
+                    .collect();
+                let got = lerp(&table.roughness, &rows, r);
+                worst = worst.max((got - want).abs());
+            }
+        }
+        eprintln!("worst interpolation error {worst}");
+        assert!(worst < MAX_INTERPOLATION_ERROR, "worst {worst}");
+        assert!(worst > 0.0, "points between the grid's are interpolated");
+    }
+
+    #[test]
+    fn the_catalogue_carries_every_rule_and_the_twin_groups() {
+        let v = BlenderVersion { major: 4, minor: 5 };
+        let json: serde_json::Value = serde_json::from_str(&to_json(v)).unwrap();
+        let ids: Vec<&str> = json["rules"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["id"].as_str().unwrap())
+            .collect();
+        assert_eq!(ids, RULES.iter().map(|r| r.id).collect::<Vec<_>>());
+        assert_eq!(json["rules"][6]["before"], serde_json::json!([4, 0]));
+        assert!(json["twin_names"]["multiscatter"]["BECKMANN"].is_string());
+        assert_eq!(json["predictions"]["blender"], serde_json::json!([4, 5]));
+        assert_eq!(json["tolerance"], 0.01);
+    }
+}
