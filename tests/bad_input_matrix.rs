@@ -337,8 +337,23 @@ fn cases() -> Vec<Case> {
         // --- generate -----------------------------------------------------------------
         case(&["generate"]).no_blender().says(&[
             "(no output)",
-            "--script OUT.py, --blend OUT.blend, --into EXISTING.blend or --extension OUT.zip",
+            "--script OUT.py, --blend OUT.blend, --into EXISTING.blend, --extension OUT.zip or \
+             --addon OUT.zip",
         ]),
+        case(&["generate", "--addon", "@/gloffuse.tar"])
+            .no_blender()
+            .says(&[
+                "invalid --addon '@/gloffuse.tar'",
+                "a file name ending in .zip",
+            ])
+            .writes_nothing_to(&["@/gloffuse.tar"]),
+        case(&["generate", "--extension", "@/g.zip", "--addon", "@/g.zip"])
+            .no_blender()
+            .says(&[
+                "invalid --addon '@/g.zip'",
+                "a file other than the --extension",
+            ])
+            .writes_nothing_to(&["@/g.zip"]),
         case(&["generate", "--extension", "@/gloffuse.tar"])
             .no_blender()
             .says(&[

@@ -1,5 +1,6 @@
 //! The audit inside Blender (issue 42): the extension `gloffuse generate --extension`
-//! builds, installed as Blender installs it, gives every material of the audit's test
+//! builds (in 4.5 and 5.0), or the classic add-on `--addon` builds (in 3.4, by 3.4),
+//! installed as Blender installs it, gives every material of the audit's test
 //! library (tests/blender/audit_library.py: rules.blend, nested.blend, unusual.blend)
 //! through its operators the verdict, reason, findings and predictions `gloffuse audit
 //! --no-render --json` gives on the same files (the oracle), fixes exactly what `gloffuse
@@ -20,32 +21,40 @@ use serde_json::Value;
 
 const FILES: [&str; 3] = ["rules.blend", "nested/deeper/nested.blend", "unusual.blend"];
 
-/// The extension, built once per test process by bpy 4.5 (else the Blender under test):
-/// the one zip each Blender installs, as a user's would be.
-fn extension(fallback: &Path) -> PathBuf {
+/// What a Blender installs: the extension, built once per test process by bpy 4.5 (else
+/// the Blender under test), the one zip each 4.2+ Blender installs as a user's would be;
+/// before 4.2, the classic add-on built by that Blender. Returns the zip and whether it is
+/// the classic add-on.
+fn installable(label: &str, blender: &Path) -> (PathBuf, bool) {
     static ZIP: OnceLock<PathBuf> = OnceLock::new();
-    ZIP.get_or_init(|| {
-        let builder = real_blender("4.5").unwrap_or_else(|| fallback.to_path_buf());
+    let build = |flag: &str, builder: &Path, name: &str| {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("blender-panel");
-        let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        let zip = dir.join("gloffuse.zip");
+        let zip = dir.join(name);
+        let _ = std::fs::remove_file(&zip);
         common::gloffuse()
             .args([
                 "generate",
                 "--mode",
                 "multiscatter,layered,anisotropic,glass",
-                "--extension",
+                flag,
             ])
             .arg(&zip)
             .arg("--blender")
-            .arg(&builder)
+            .arg(builder)
             .args(["--no-provision", "--timeout", "300"])
             .assert()
             .success();
         zip
-    })
-    .clone()
+    };
+    if label.starts_with("3.") {
+        return (build("--addon", blender, "gloffuse-addon-3.zip"), true);
+    }
+    let zip = ZIP.get_or_init(|| {
+        let builder = real_blender("4.5").unwrap_or_else(|| blender.to_path_buf());
+        build("--extension", &builder, "gloffuse.zip")
+    });
+    (zip.clone(), false)
 }
 
 /// `gloffuse audit --no-render --json` on the library's files with `extra` arguments: the
@@ -70,7 +79,7 @@ fn audit(blender: &Path, files: &[PathBuf], extra: &[&str], report: &Path) -> Va
 }
 
 fn the_panel_agrees_with_the_audit(label: &'static str, blender: PathBuf) {
-    let zip = extension(&blender);
+    let (zip, classic) = installable(label, &blender);
     let dir = tempfile::tempdir().unwrap();
     let library = dir.path().join("library");
     common::audit_library::make_library(&blender, &library, None);
@@ -117,6 +126,9 @@ fn the_panel_agrees_with_the_audit(label: &'static str, blender: PathBuf) {
         "--out".as_ref(),
         result.as_os_str(),
     ];
+    if classic {
+        args.push("--addon".as_ref());
+    }
     args.extend(files.iter().map(|f| f.as_os_str()));
     let run = run_in_blender(&blender, checker.as_ref(), &args);
     let seen: Value = std::fs::read_to_string(&result)
@@ -155,4 +167,4 @@ fn rewritten_in(report: &Value, name: &str) -> usize {
         .count()
 }
 
-per_blender!(the_panel_agrees_with_the_audit: in_blender_4_5, in_blender_5_0);
+per_blender!(the_panel_agrees_with_the_audit);

@@ -2,10 +2,11 @@
 # Copyright (C) 2026 the gloffuse authors
 """gloffuse: Blender's glossy BSDFs at full brightness, as an asset library.
 
-The extension bundles a library .blend of gloffuse node groups (CC0) and its
-asset catalogs. Enabling it copies them into the extension's user directory
-(the extension's own folder is replaced on every update and may be read-only)
-and registers that directory as the asset library "Gloffuse"; disabling it
+The extension (Blender 4.2+), or the same add-on packed as a classic add-on
+(3.4 to 4.1), bundles a library .blend of gloffuse node groups (CC0) and its
+asset catalogs. Enabling it copies them into the add-on's user folder (its own
+folder is replaced on every update and may be read-only; compat.py's
+addon_user_folder) and registers that directory as the asset library "Gloffuse"; disabling it
 removes the library again. The groups then show in the Asset Browser and, in
 the shader editor, under Add > Shader.
 
@@ -21,6 +22,7 @@ import shutil
 
 import bpy
 
+from .compat import add_asset_library, addon_user_folder, remove_asset_library
 from .panel_ui import register_panel, unregister_panel
 
 LIBRARY_NAME = "Gloffuse"
@@ -30,7 +32,7 @@ BUNDLED = os.path.join(os.path.dirname(__file__), "library")
 def _user_library():
     """The library folder in the extension's user directory, brought up to date
     with the bundled files (each replaced whole, never half-written)."""
-    directory = bpy.utils.extension_path_user(__package__, path="library", create=True)
+    directory = addon_user_folder(__package__, "library", create=True)
     for name in sorted(os.listdir(BUNDLED)):
         source = os.path.join(BUNDLED, name)
         target = os.path.join(directory, name)
@@ -58,13 +60,12 @@ def register():
         # Blender's default import method for a new library (Append (Reuse Data)
         # in 4.x, Pack in 5.0) copies a group into the user's file: materials keep
         # working after the extension is disabled or removed.
-        bpy.context.preferences.filepaths.asset_libraries.new(
-            name=LIBRARY_NAME, directory=directory)
+        add_asset_library(LIBRARY_NAME, directory)
 
 
 def unregister():
     unregister_panel()
-    directory = bpy.utils.extension_path_user(__package__, path="library", create=False)
+    directory = addon_user_folder(__package__, "library", create=False)
     library = _registered(directory)
     if library is not None:
-        bpy.context.preferences.filepaths.asset_libraries.remove(library)
+        remove_asset_library(library)

@@ -451,6 +451,46 @@ def inputs_added_as_before(node):
     return left_out
 
 
+# --- the add-on (addon.py) ----------------------------------------------------
+
+def addon_user_folder(package, name, create):
+    """A folder for the add-on's own files under Blender's user resources: the
+    extension's user directory (4.2+, package "bl_ext.REPOSITORY.gloffuse"), or,
+    for the classic add-on (3.4 to 4.1, or a legacy add-on in 4.2+, package
+    "gloffuse"), datafiles/PACKAGE/NAME; either survives the add-on's updates."""
+    if package.startswith("bl_ext.") and hasattr(bpy.utils, "extension_path_user"):
+        return bpy.utils.extension_path_user(package, path=name, create=create)
+    return bpy.utils.user_resource("DATAFILES", path=os.path.join(package, name), create=create)
+
+
+def add_asset_library(name, directory):
+    """Register `directory` as the asset library `name`. Before 4.x the
+    preferences' collection has no new(); its operator adds one named after the
+    folder, renamed here."""
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    if hasattr(libraries, "new"):
+        libraries.new(name=name, directory=directory)
+        return
+    # An add-on's register() runs in a restricted context, which bpy.ops's wrapper
+    # refuses (it updates the view layer first); the operator itself needs none.
+    from _bpy import ops as operators  # noqa: PLC0415 -- this one old path only
+
+    operators.call("preferences.asset_library_add", None, {"directory": directory})
+    libraries[-1].name = name
+
+
+def remove_asset_library(library):
+    """Unregister an asset library of the preferences (by its operator before 4.x)."""
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    if hasattr(libraries, "remove"):
+        libraries.remove(library)
+        return
+    from _bpy import ops as operators  # noqa: PLC0415 -- as add_asset_library
+
+    operators.call("preferences.asset_library_remove", None,
+                   {"index": list(libraries).index(library)})
+
+
 # --- audit (audit_rules.py, audit_twin.py, audit_job.py) ---------------------------
 
 def version_in_range(first, before):

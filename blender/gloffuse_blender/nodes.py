@@ -9,6 +9,7 @@
 # ---------------------------------------------------------------------------
 import hashlib
 import json
+import re
 
 import bpy
 
@@ -159,11 +160,16 @@ def _rna_value(value):
         return repr(value)
 
 
+# Blender's ".001" on a datablock appended beside one of the same name: a group
+# appended from the library after another one brings its own copy of their table.
+DUPLICATE_SUFFIX = re.compile(r"\.\d{3,}$")
+
+
 def _node_content(node, stack):
     """What a node renders with: its type, mute, its own settings (every
     writable property a plain node lacks), its unlinked inputs' values (but
     those a newer Blender adds at a value that changes nothing), and a nested
-    group's content or an image's name."""
+    group's content or an image's name (without a duplicate's suffix)."""
     base = {prop.identifier for prop in bpy.types.Node.bl_rna.properties}
     settings = {prop.identifier: _rna_value(getattr(node, prop.identifier))
                 for prop in node.bl_rna.properties
@@ -176,7 +182,7 @@ def _node_content(node, stack):
     image = getattr(node, "image", None)
     return [node.name, node.bl_idname, bool(node.mute), settings, inputs,
             None if tree is None else _tree_content(tree, stack),
-            None if image is None else image.name]
+            None if image is None else DUPLICATE_SUFFIX.sub("", image.name)]
 
 
 def _tree_content(tree, stack=()):

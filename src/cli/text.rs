@@ -36,6 +36,9 @@ pub fn generated(out: &Generated) -> String {
     if let Some(p) = &out.extension {
         let _ = writeln!(s, "extension: {}", p.display());
     }
+    if let Some(p) = &out.addon {
+        let _ = writeln!(s, "add-on: {}", p.display());
+    }
     let _ = writeln!(s, "coefficients: {}", out.coefficients);
     if let Some(suits) = &out.suits {
         let _ = writeln!(s, "suits: {suits}");

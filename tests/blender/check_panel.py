@@ -1,7 +1,8 @@
 """Checks the gloffuse extension's audit panel and operators (issue 42) in real
-Blender 4.2+ (the bpy module), against `gloffuse audit` as the oracle:
+Blender 4.2+ (the bpy module), or the classic add-on's in 3.4 to 4.1 (with --addon),
+against `gloffuse audit` as the oracle:
 
-    python check_panel.py -- --zip gloffuse.zip --user-resources EMPTY_DIR \
+    python check_panel.py -- --zip gloffuse.zip [--addon] --user-resources EMPTY_DIR \
         --oracle ORACLE.json --fix-report FIX.json --fixed-dir FIXED_DIR --out RESULT.json FILE.blend ...
 
 ORACLE.json: `gloffuse audit --no-render --json FILE.blend ...`; FIX.json and
@@ -10,7 +11,9 @@ FILE.blend ...` (which materials it rewrote) and where it wrote the fixed copies
 (by file name). In one Blender:
 
   1. the zip installs and enables headless (`bpy.ops.extensions.package_install_files`
-     into the "user_default" repository, in a fresh user-resources folder); the three
+     into the "user_default" repository; a classic add-on by `preferences.addon_install`
+     and `addon_enable`), in a fresh user-resources folder, and registers its asset
+     library; the three
      operators exist, and the two that change data have REGISTER and UNDO;
   2. per file: before an audit every material is "not-judged"; gloffuse.audit_material
      (each material made active in turn) and then gloffuse.audit_file give each
@@ -46,6 +49,7 @@ def args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
     parser = argparse.ArgumentParser()
     parser.add_argument("--zip", required=True)
+    parser.add_argument("--addon", action="store_true", help="the zip is a classic add-on")
     parser.add_argument("--user-resources", required=True)
     parser.add_argument("--oracle", required=True)
     parser.add_argument("--fix-report", required=True)
@@ -56,11 +60,15 @@ def args():
 
 
 OPTIONS = args()
+# Where Blender keeps a user's add-ons and their files: read at start-up by 4.2+'s bpy
+# module, at each use by 3.4 (which knows only the three separate folders).
 os.environ["BLENDER_USER_RESOURCES"] = OPTIONS.user_resources
+for _kind in ("SCRIPTS", "DATAFILES", "CONFIG"):
+    os.environ["BLENDER_USER_" + _kind] = os.path.join(OPTIONS.user_resources, _kind.lower())
 
 import bpy  # noqa: E402 -- after the environment it reads at start-up
 
-MODULE = "bl_ext.user_default.gloffuse"
+MODULE = "gloffuse" if OPTIONS.addon else "bl_ext.user_default.gloffuse"
 TWIN_GROUP = re.compile(r"^Gloffuse (Multiscatter|Layered) \(")
 
 
@@ -162,12 +170,22 @@ def material_tree(material):
 # --- the checks ----------------------------------------------------------------------------
 
 def install(options, failures, seen):
-    result = bpy.ops.extensions.package_install_files(
-        filepath=os.path.abspath(options.zip), repo="user_default", enable_on_install=True)
+    if options.addon:
+        result = bpy.ops.preferences.addon_install(filepath=os.path.abspath(options.zip))
+        if result == {"FINISHED"}:
+            result = bpy.ops.preferences.addon_enable(module=MODULE)
+    else:
+        result = bpy.ops.extensions.package_install_files(
+            filepath=os.path.abspath(options.zip), repo="user_default", enable_on_install=True)
     seen["install"] = sorted(result)
     if MODULE not in bpy.context.preferences.addons:
         failures.append("installing did not enable %s (%s)" % (MODULE, result))
         return False
+    libraries = {library.name: library.path for library in bpy.context.preferences.filepaths.asset_libraries}
+    seen["asset_library"] = libraries.get("Gloffuse")
+    if seen["asset_library"] is None or not os.path.isfile(
+            os.path.join(bpy.path.abspath(seen["asset_library"]), "gloffuse.blend")):
+        failures.append("no asset library Gloffuse holding gloffuse.blend: %s" % libraries)
     for name, undo in (("audit_material", True), ("audit_file", True), ("fix_material", True)):
         cls = getattr(bpy.types, "GLOFFUSE_OT_" + name, None)
         if cls is None:

@@ -176,6 +176,8 @@ pub enum Field {
     Engine,
     /// The Blender extension (.zip) to write.
     Extension,
+    /// The classic add-on (.zip) to write.
+    Addon,
     /// Replace an existing file that is not what a command would replace unasked (a
     /// library .blend that is not a gloffuse library).
     Force,
@@ -265,6 +267,7 @@ impl Field {
             Field::Distribution => "distribution",
             Field::Engine => "engine",
             Field::Extension => "extension",
+            Field::Addon => "add-on",
             Field::Force => "force",
             Field::Format => "format",
             Field::GModel => "masking model",

@@ -11,6 +11,8 @@ use gloffuse::measure::Engine;
 pub(super) const GENERATE_EXAMPLES: &str = "\
 Examples:
   gloffuse generate --extension gloffuse.zip     an extension to install in Blender 4.2+
+  gloffuse generate --addon gloffuse-addon.zip --blender /usr/bin/blender
+                                                 a classic add-on for Blender 3.4 to 4.1
   gloffuse generate --blend lib/gloffuse.blend --mode roughness,view
                                                  a library .blend with the view groups too
   gloffuse generate --blend lib/gloffuse.blend --mode layered
@@ -61,6 +63,13 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "OUT.zip", conflicts_with = "into")]
     pub extension: Option<PathBuf>,
 
+    /// Write the same add-on as a classic add-on, for Blender 3.4 to 4.1 (Edit ▸
+    /// Preferences ▸ Add-ons ▸ Install, then tick "Material: Gloffuse"): the asset library,
+    /// the Gloffuse panel and its operators. Build it with the oldest Blender it is for (it
+    /// runs in that version and later; --blender picks one).
+    #[arg(long, value_name = "OUT.zip", conflicts_with = "into")]
+    pub addon: Option<PathBuf>,
+
     /// Which groups to build besides the roughness-only pair (repeatable): view adds
     /// `Brightness Correction View (…)` and `Gloffuse View (…)` (gain 1/E(μ, r)), and
     /// multiscatter adds `Gloffuse Multiscatter (…)`; both add the packed E(μ, r) table.
@@ -97,6 +106,7 @@ impl GenerateArgs {
             allow_downgrade: self.allow_downgrade,
             force: self.force,
             extension: self.extension.clone(),
+            addon: self.addon.clone(),
             audit_catalogue: Some(gloffuse::audit::catalogue::EXTENSION),
             modes: self.mode.clone(),
             engines: self.engine.clone(),

@@ -164,6 +164,7 @@ pub fn flag(field: Field) -> String {
         Field::Distribution => "--distribution",
         Field::Engine => "--engine",
         Field::Extension => "--extension",
+        Field::Addon => "--addon",
         Field::Force => "--force",
         Field::Format => "--format",
         Field::GModel => "--g-model",

@@ -99,30 +99,70 @@ pub fn can_build(built_with: BlenderVersion) -> Result<(), Error> {
     Ok(())
 }
 
-/// The extension's .zip, from the library .blend and its catalog file, built by Blender
-/// `built_with` (4.2 or later), with the audit's data when `audit` is given (without it the
-/// panel says it has none). Entries are stored with a fixed date, so the same inputs give
-/// the same bytes.
+/// How Blender installs the .zip: as an extension (4.2 and later: a manifest beside the
+/// add-on) or as a classic add-on (3.4 to 4.1, and 4.2 and later as a legacy add-on: one
+/// folder, named [`ID`], whose `__init__.py` opens with `bl_info`). The add-on is the same.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Packaging {
+    Extension,
+    Addon,
+}
+
+/// The classic add-on's `bl_info`, which Blender reads without running the add-on.
+/// `blender` is the Blender that saved the library: an older one may not read the file.
+pub fn bl_info(built_with: BlenderVersion) -> String {
+    let version: Vec<&str> = env!("CARGO_PKG_VERSION").split('.').collect();
+    format!(
+        r#"# SPDX-License-Identifier: GPL-3.0-or-later
+bl_info = {{
+    "name": "Gloffuse",
+    "author": "The gloffuse authors",
+    "version": ({}),
+    "blender": ({}, {}, 0),
+    "location": "Properties > Material > Gloffuse, Shader Editor > Sidebar > Gloffuse",
+    "description": "Glossy node groups that keep their brightness at any roughness",
+    "category": "Material",
+}}
+"#,
+        version.join(", "),
+        built_with.major,
+        built_with.minor,
+    )
+}
+
+/// The .zip, from the library .blend and its catalog file, built by Blender `built_with`
+/// (4.2 or later for an extension), with the audit's data when `audit` is given (without
+/// it the panel says it has none). Entries are stored with a fixed date, so the same
+/// inputs give the same bytes.
 pub fn package(
+    packaging: Packaging,
     blend: &[u8],
     catalogs: &str,
     built_with: BlenderVersion,
     audit: Option<AuditCatalogue>,
 ) -> Result<Vec<u8>, Error> {
-    can_build(built_with)?;
-    let manifest = manifest(built_with);
-    let addon = super::bundle::addon();
+    let (folder, first, init) = match packaging {
+        Packaging::Extension => {
+            can_build(built_with)?;
+            (String::new(), Some(manifest(built_with)), String::new())
+        }
+        Packaging::Addon => (format!("{ID}/"), None, bl_info(built_with)),
+    };
+    let init = init + &super::bundle::addon();
     let audit = audit.map(|a| (a.file_name.to_string(), (a.write)(built_with)));
-    let mut files: Vec<(String, &[u8])> = vec![
-        ("blender_manifest.toml".into(), manifest.as_bytes()),
-        ("__init__.py".into(), addon.as_bytes()),
+    let mut files: Vec<(String, &[u8])> = Vec::new();
+    if let Some(manifest) = &first {
+        files.push(("blender_manifest.toml".into(), manifest.as_bytes()));
+    }
+    files.extend([
+        ("__init__.py".into(), init.as_bytes()),
         ("LICENSE".into(), LICENSE.as_bytes()),
         (format!("{LIBRARY_FOLDER}/{LIBRARY_FILE}"), blend),
         (
             format!("{LIBRARY_FOLDER}/{}", super::catalogs::FILE_NAME),
             catalogs.as_bytes(),
         ),
-    ];
+    ]);
     if let Some((name, text)) = &audit {
         files.push((name.clone(), text.as_bytes()));
     }
@@ -132,11 +172,12 @@ pub fn package(
         .last_modified_time(DateTime::default())
         .unix_permissions(0o644);
     let failed = |e: &dyn std::fmt::Display| Error::Write {
-        path: "(the extension archive, in memory)".into(),
+        path: "(the add-on archive, in memory)".into(),
         message: e.to_string(),
     };
     for (name, bytes) in files {
-        zip.start_file(name, options).map_err(|e| failed(&e))?;
+        zip.start_file(format!("{folder}{name}"), options)
+            .map_err(|e| failed(&e))?;
         zip.write_all(bytes).map_err(|e| failed(&e))?;
     }
     Ok(zip.finish().map_err(|e| failed(&e))?.into_inner())
@@ -154,10 +195,24 @@ mod tests {
             file_name: "audit.json",
             write: |v| format!("{{\"blender\": [{}, {}]}}", v.major, v.minor),
         };
-        let bytes = package(b"BLENDER-fake", "VERSION 1\n", v45, Some(audit)).unwrap();
+        let bytes = package(
+            Packaging::Extension,
+            b"BLENDER-fake",
+            "VERSION 1\n",
+            v45,
+            Some(audit),
+        )
+        .unwrap();
         assert_eq!(
             bytes,
-            package(b"BLENDER-fake", "VERSION 1\n", v45, Some(audit)).unwrap()
+            package(
+                Packaging::Extension,
+                b"BLENDER-fake",
+                "VERSION 1\n",
+                v45,
+                Some(audit)
+            )
+            .unwrap()
         );
         let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
         let mut names: Vec<String> = archive
@@ -201,7 +256,41 @@ mod tests {
 
     #[test]
     fn blender_before_4_2_cannot_build_one() {
-        let err = package(b"", "", BlenderVersion { major: 3, minor: 4 }, None).unwrap_err();
+        let v34 = BlenderVersion { major: 3, minor: 4 };
+        let err = package(Packaging::Extension, b"", "", v34, None).unwrap_err();
         assert!(err.to_string().contains("4.2 or later"), "{err}");
+    }
+
+    #[test]
+    fn the_addon_is_one_folder_whose_init_opens_with_bl_info() {
+        let v34 = BlenderVersion { major: 3, minor: 4 };
+        let bytes = package(Packaging::Addon, b"BLENDER-fake", "VERSION 1\n", v34, None).unwrap();
+        let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+        let mut names: Vec<String> = archive
+            .file_names()
+            .map(|n| n.unwrap().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "gloffuse/LICENSE",
+                "gloffuse/__init__.py",
+                "gloffuse/library/blender_assets.cats.txt",
+                "gloffuse/library/gloffuse.blend"
+            ]
+        );
+        let mut init = String::new();
+        archive
+            .by_name("gloffuse/__init__.py")
+            .unwrap()
+            .read_to_string(&mut init)
+            .unwrap();
+        let lines: Vec<&str> = init.lines().take(6).collect();
+        assert_eq!(lines[1], "bl_info = {", "{init:.300}");
+        assert_eq!(lines[5], "    \"blender\": (3, 4, 0),");
+        let version = env!("CARGO_PKG_VERSION").replace('.', ", ");
+        assert_eq!(lines[4], format!("    \"version\": ({version}),"));
+        assert!(init.contains("def register():"));
     }
 }

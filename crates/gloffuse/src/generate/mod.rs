@@ -38,6 +38,7 @@ use crate::output::{Destination, check_destination, keep_beside, temp_beside, wr
 use crate::progress::Progress;
 use crate::user_blend::{LockedBlend, UserBlend};
 use blend::incomplete_blend;
+use extension::Packaging;
 
 /// What `generate` writes, and from what.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,7 +58,9 @@ pub struct GenerateOptions {
     pub force: bool,
     /// Write a Blender extension (.zip) that installs the library as an asset library.
     pub extension: Option<PathBuf>,
-    /// The audit's data the extension's panel reads (the audit is a later stage: the
+    /// Write the same add-on as a classic add-on (.zip) for Blender 3.4 to 4.1.
+    pub addon: Option<PathBuf>,
+    /// The audit's data the add-on's panel reads (the audit is a later stage: the
     /// caller hands in `gloffuse::audit::catalogue::EXTENSION`); none: its panel has none.
     pub audit_catalogue: Option<extension::AuditCatalogue>,
     /// Which groups to build besides the roughness-only pair.
@@ -78,12 +81,31 @@ impl Default for GenerateOptions {
             allow_downgrade: false,
             force: false,
             extension: None,
+            addon: None,
             audit_catalogue: None,
             modes: vec![Mode::Roughness],
             engines: Vec::new(),
             color_model: ColorModel::Exact,
             blender: BlenderOptions::default(),
         }
+    }
+}
+
+impl GenerateOptions {
+    /// The .zip files asked for: how each is packed, where it goes, and its flag.
+    fn zips(&self) -> Vec<(Packaging, &PathBuf, Field)> {
+        [
+            (Packaging::Extension, &self.extension, Field::Extension),
+            (Packaging::Addon, &self.addon, Field::Addon),
+        ]
+        .into_iter()
+        .filter_map(|(packaging, zip, field)| Some((packaging, zip.as_ref()?, field)))
+        .collect()
+    }
+
+    /// Whether a new library is made (a .blend, or one packed into a .zip).
+    fn makes_a_library(&self) -> bool {
+        self.blend.is_some() || !self.zips().is_empty()
     }
 }
 
@@ -98,6 +120,7 @@ pub struct Generated {
     /// The catalog definition file written (merged) beside a new .blend.
     pub catalogs: Option<PathBuf>,
     pub extension: Option<PathBuf>,
+    pub addon: Option<PathBuf>,
     /// The Blenders the groups built suit (by the Blender that saved them and the masking
     /// their Cycles corrections fit), when a Blender ran.
     pub suits: Option<String>,
@@ -119,7 +142,7 @@ pub struct RenamedGroup {
 
 /// Refuses what cannot work before anything is looked for or written.
 fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
-    if [&g.script, &g.blend, &g.into, &g.extension]
+    if [&g.script, &g.blend, &g.into, &g.extension, &g.addon]
         .iter()
         .all(|o| o.is_none())
     {
@@ -127,8 +150,14 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
             Field::Arguments,
             "(no output)",
             Hint::new(
-                "{} OUT.py, {} OUT.blend, {} EXISTING.blend or {} OUT.zip",
-                [Field::Script, Field::Blend, Field::Into, Field::Extension],
+                "{} OUT.py, {} OUT.blend, {} EXISTING.blend, {} OUT.zip or {} OUT.zip",
+                [
+                    Field::Script,
+                    Field::Blend,
+                    Field::Into,
+                    Field::Extension,
+                    Field::Addon,
+                ],
             ),
         ));
     }
@@ -147,25 +176,38 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
                 Hint::text(expected),
             ));
         }
-        if g.blend.is_some() || g.extension.is_some() {
+        if g.makes_a_library() {
             return Err(Error::input(
                 Field::Into,
                 into.display(),
                 Hint::new(
-                    "{} alone (with {} at most): {} and {} make a new library, {} changes \
-                     your file in place",
+                    "{} alone (with {} at most): {}, {} and {} make a new library, {} \
+                     changes your file in place",
                     [
                         Field::Into,
                         Field::Script,
                         Field::Blend,
                         Field::Extension,
+                        Field::Addon,
                         Field::Into,
                     ],
                 ),
             ));
         }
     }
-    if let Some(zip) = &g.extension {
+    check_zips(g)?;
+    for out in [&g.blend, &g.script, &g.extension, &g.addon]
+        .into_iter()
+        .flatten()
+    {
+        check_destination(out)?;
+    }
+    Ok(())
+}
+
+/// Each .zip asked for is named .zip (or is a stream), and the two are not one file.
+fn check_zips(g: &GenerateOptions) -> Result<(), Error> {
+    for (_, zip, field) in g.zips() {
         let named_zip = zip
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("zip"));
@@ -176,14 +218,18 @@ fn check_inputs(g: &GenerateOptions) -> Result<(), Error> {
             )
         {
             return Err(Error::input(
-                Field::Extension,
+                field,
                 zip.display(),
-                "a file name ending in .zip (Blender installs extensions from a .zip)",
+                "a file name ending in .zip (Blender installs add-ons from a .zip)",
             ));
         }
     }
-    for out in [&g.blend, &g.script, &g.extension].into_iter().flatten() {
-        check_destination(out)?;
+    if g.extension.is_some() && g.extension == g.addon {
+        return Err(Error::input(
+            Field::Addon,
+            g.addon.as_ref().unwrap().display(),
+            Hint::new("a file other than the {}", [Field::Extension]),
+        ));
     }
     Ok(())
 }
@@ -247,6 +293,7 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
         backup: None,
         catalogs: None,
         extension: None,
+        addon: None,
         suits: (blender.as_ref())
             .map(|b| suits::library(pinned.as_ref().map(|p| p.1), &engines, b.version)),
         groups: params.group_names(),
@@ -275,15 +322,12 @@ pub fn generate(g: &GenerateOptions, progress: &dyn Progress) -> Result<Generate
     }
     // Everything is made before anything is written: a failed run leaves no output at all,
     // and the catalog file is staged (under its lock) before the library is replaced.
-    let package = package_extension(g, &built, &params, &blender)?;
+    let packages = package_zips(g, &built, &params, &blender)?;
     let catalogs = catalogs
         .map(|file| catalogs::stage(&file, &params.catalogs))
         .transpose()?;
     write_script(g, &script, &mut out)?;
-    if let (Some(zip), Some(bytes)) = (&g.extension, &package) {
-        write_output(zip, bytes)?;
-        out.extension = Some(zip.clone());
-    }
+    write_zips(&packages, &mut out)?;
     g.blender.cancel.check()?;
     // The library and its catalogs change together or not at all: the library's previous
     // version is kept until the catalog file is in place, and put back if it cannot be.
@@ -338,7 +382,7 @@ fn pinned_coefficients(g: &GenerateOptions) -> Result<Option<(Coefficients, &str
 /// it must be able to build an extension if one is asked for, and should be as new as the
 /// file to update (else saving it would lose what that Blender does not know).
 fn blender_for(g: &GenerateOptions, progress: &dyn Progress) -> Result<Option<Blender>, Error> {
-    let needs_blender = g.blend.is_some() || g.into.is_some() || g.extension.is_some();
+    let needs_blender = g.into.is_some() || g.makes_a_library();
     if !needs_blender {
         return Ok(None);
     }
@@ -368,7 +412,7 @@ fn script_params(
         None => Curves::Presets(engines),
     };
     let mut params = GenerateParams::new(curves, &Masking::ALL, &g.modes, g.color_model)?;
-    params.previews = g.blend.is_some() || g.extension.is_some();
+    params.previews = g.makes_a_library();
     Ok(params)
 }
 
@@ -602,27 +646,50 @@ fn job_report(g: &GenerateOptions, result: &serde_json::Value) -> Result<Vec<Ren
         .collect())
 }
 
-/// The extension's .zip in memory, if one is asked for: the saved .blend and its catalogs.
-fn package_extension(
+/// The .zip files asked for, in memory, with where each goes: the saved .blend and its
+/// catalogs packed as an extension or a classic add-on.
+fn package_zips(
     g: &GenerateOptions,
     built: &Built,
     params: &GenerateParams,
     blender: &Blender,
-) -> Result<Option<Vec<u8>>, Error> {
-    if g.extension.is_none() {
-        return Ok(None);
+) -> Result<Vec<(Packaging, PathBuf, Vec<u8>)>, Error> {
+    let zips = g.zips();
+    if zips.is_empty() {
+        return Ok(Vec::new());
     }
     let blend = std::fs::read(&built.tmp).map_err(|source| Error::Read {
         path: built.tmp.to_path_buf(),
         source,
     })?;
     let catalogs = params.catalogs.definition_file();
-    Ok(Some(extension::package(
-        &blend,
-        &catalogs,
-        blender.version,
-        g.audit_catalogue,
-    )?))
+    zips.into_iter()
+        .map(|(packaging, zip, _)| {
+            let bytes = extension::package(
+                packaging,
+                &blend,
+                &catalogs,
+                blender.version,
+                g.audit_catalogue,
+            )?;
+            Ok((packaging, zip.clone(), bytes))
+        })
+        .collect()
+}
+
+/// Writes the packed .zip files and says where.
+fn write_zips(
+    packages: &[(Packaging, PathBuf, Vec<u8>)],
+    out: &mut Generated,
+) -> Result<(), Error> {
+    for (packaging, zip, bytes) in packages {
+        write_output(zip, bytes)?;
+        match packaging {
+            Packaging::Extension => out.extension = Some(zip.clone()),
+            Packaging::Addon => out.addon = Some(zip.clone()),
+        }
+    }
+    Ok(())
 }
 
 /// Puts the saved .blend in its destination, if it has one: the user's file replaced the
