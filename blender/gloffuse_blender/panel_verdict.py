@@ -27,7 +27,7 @@ import bpy
 
 from .audit_rules import MULTISCATTER_TWIN, TWIN_KINDS, applicable_rules, scan_material, twin_groups
 from .audit_twin import apply_finding, has_replacement
-from .compat import material_node_tree
+from .compat import blender_at_least, material_node_tree
 
 CATALOGUE_FILE = "audit_catalogue.json"
 PATH_SEPARATOR = " \u25b8 "  # "A ▸ B", as the audit's reports join a node's path
@@ -37,13 +37,19 @@ VERDICT_RANK = {"error": 0, "creates": 1, "loses": 2, "not-judged": 3, "ok": 4}
 
 
 def load_catalogue(directory):
-    """The catalogue beside the add-on, or None: an extension built without it (by
-    gloffuse's library, not its command line) has no audit."""
+    """The catalogue beside the add-on, as this Blender reads it (the twins' names and
+    predictions of the newest `by_blender` entry not after it), or None: an add-on
+    built without it (by gloffuse's library, not its command line), or by a newer
+    Blender than this one, has no audit."""
     path = os.path.join(directory, CATALOGUE_FILE)
     if not os.path.isfile(path):
         return None
     with open(path, encoding="utf-8") as f:
-        return json.load(f)
+        catalogue = json.load(f)
+    mine = [entry for entry in catalogue["by_blender"] if blender_at_least(entry["from"])]
+    if not mine:
+        return None
+    return dict(catalogue, twin_names=mine[-1]["twin_names"], predictions=mine[-1]["predictions"])
 
 
 def catalogue_rule(catalogue, rule_id):

@@ -6,12 +6,17 @@
 //! panel's Python (`blender/gloffuse_blender/panel_verdict.py`) only looks values up in it,
 //! so the words and numbers the panel shows are the ones `gloffuse audit --no-render` gives.
 //!
+//! The twins' names and the predictions depend on the Blender (its masking, which lobes it
+//! compensates), and an add-on built by one Blender runs in every later one: the catalogue
+//! holds them for each Blender series from the one that builds it on (`by_blender`, an
+//! entry only where they change), and the panel takes the newest entry not after its own.
+//!
 //! The predictions are [`Predictor::predict`]'s own values at the grid's points: the panel
 //! interpolates linearly in roughness (and IOR for the hand-made layering), the one part of
 //! the prediction it computes. [`MAX_INTERPOLATION_ERROR`] bounds that interpolation, checked
 //! below against the predictor between the grid's points.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use serde::Serialize;
 
@@ -19,7 +24,7 @@ use super::rules::{Predictor, RULES};
 use super::twins::TwinNames;
 use super::verdict::AuditJudging;
 use crate::generate::extension::AuditCatalogue;
-use crate::measure::{BlenderVersion, Distribution};
+use crate::measure::{BlenderVersion, Distribution, Masking};
 
 /// The file's name inside the extension.
 pub const FILE_NAME: &str = "audit_catalogue.json";
@@ -48,8 +53,6 @@ struct CatalogueRule {
 /// The predictor's values on the grid, by Blender distribution enum.
 #[derive(Clone, Debug, Serialize)]
 pub struct Predictions {
-    /// The Blender these are for (the masking depends on it).
-    pub blender: [u32; 2],
     pub roughness: Vec<f64>,
     pub ior: Vec<f64>,
     /// `glossy-single-scatter`: a white lobe's E_avg at each roughness.
@@ -68,9 +71,36 @@ pub struct Catalogue {
     /// gloffuse.toml may set another for the command line).
     pub tolerance: f64,
     rules: Vec<CatalogueRule>,
+    /// What the panel reads of its Blender, oldest first.
+    pub by_blender: Vec<ForBlender>,
+}
+
+/// The twins' names and the predictions from Blender `from` on (until the next entry).
+#[derive(Clone, Debug, Serialize)]
+pub struct ForBlender {
+    pub from: [u32; 2],
     twin_names: TwinNames,
     pub predictions: Predictions,
 }
+
+/// The Blender series an add-on may run in: every one gloffuse knows, and the two after
+/// them read in Cycles' source (newer ones take the last entry).
+const SERIES: [(u32, u32); 14] = [
+    (3, 0),
+    (3, 1),
+    (3, 2),
+    (3, 3),
+    (3, 4),
+    (3, 5),
+    (3, 6),
+    (4, 0),
+    (4, 1),
+    (4, 2),
+    (4, 3),
+    (4, 4),
+    (4, 5),
+    (5, 0),
+];
 
 fn grid(from: f64, to: f64, steps: usize) -> Vec<f64> {
     (0..=steps)
@@ -116,7 +146,6 @@ pub fn predictions(version: BlenderVersion) -> Predictions {
         layering.insert(name, table);
     }
     Predictions {
-        blender: [version.major, version.minor],
         roughness,
         ior,
         glossy,
@@ -124,7 +153,35 @@ pub fn predictions(version: BlenderVersion) -> Predictions {
     }
 }
 
-/// The catalogue for Blender `version`.
+/// The entries for Blender `built_with` and every later series, each only where the
+/// twins' names or the predictions change.
+fn by_blender(built_with: BlenderVersion) -> Vec<ForBlender> {
+    let mut entries: Vec<(String, ForBlender)> = Vec::new();
+    // The predictor depends on the Blender only through its masking: two grids at most.
+    let mut grids: HashMap<Masking, Predictions> = HashMap::new();
+    let later = SERIES
+        .iter()
+        .map(|&(major, minor)| BlenderVersion { major, minor })
+        .filter(|&v| v > built_with);
+    for version in std::iter::once(built_with).chain(later) {
+        let entry = ForBlender {
+            from: [version.major, version.minor],
+            twin_names: TwinNames::new(version),
+            predictions: grids
+                .entry(version.masking())
+                .or_insert_with(|| predictions(version))
+                .clone(),
+        };
+        let same = serde_json::to_string(&(&entry.twin_names, &entry.predictions))
+            .expect("an entry serialises");
+        if entries.last().is_none_or(|(last, _)| *last != same) {
+            entries.push((same, entry));
+        }
+    }
+    entries.into_iter().map(|(_, entry)| entry).collect()
+}
+
+/// The catalogue an add-on built by Blender `version` carries.
 pub fn catalogue(version: BlenderVersion) -> Catalogue {
     Catalogue {
         gloffuse: env!("CARGO_PKG_VERSION"),
@@ -141,8 +198,7 @@ pub fn catalogue(version: BlenderVersion) -> Catalogue {
                 fix: r.fix,
             })
             .collect(),
-        twin_names: TwinNames::new(version),
-        predictions: predictions(version),
+        by_blender: by_blender(version),
     }
 }
 
@@ -221,8 +277,52 @@ mod tests {
             .collect();
         assert_eq!(ids, RULES.iter().map(|r| r.id).collect::<Vec<_>>());
         assert_eq!(json["rules"][6]["before"], serde_json::json!([4, 0]));
-        assert!(json["twin_names"]["multiscatter"]["BECKMANN"].is_string());
-        assert_eq!(json["predictions"]["blender"], serde_json::json!([4, 5]));
+        assert!(json["by_blender"][0]["twin_names"]["multiscatter"]["BECKMANN"].is_string());
+        assert_eq!(json["by_blender"][0]["from"], serde_json::json!([4, 5]));
         assert_eq!(json["tolerance"], 0.01);
+    }
+
+    /// The entry a Blender takes, as panel_verdict.py takes it: the newest not after it.
+    fn entry_for(json: &serde_json::Value, major: u32, minor: u32) -> &serde_json::Value {
+        json["by_blender"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .rfind(|e| {
+                e["from"][0].as_u64().unwrap() * 100 + e["from"][1].as_u64().unwrap()
+                    <= u64::from(major * 100 + minor)
+            })
+            .unwrap()
+    }
+
+    #[test]
+    fn every_later_blender_finds_its_own_twins_and_predictions() {
+        let v34 = BlenderVersion { major: 3, minor: 4 };
+        let json: serde_json::Value = serde_json::from_str(&to_json(v34)).unwrap();
+        let from: Vec<&serde_json::Value> = json["by_blender"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| &e["from"])
+            .collect();
+        // 3.5 changes the masking, 3.6 the glass twin; no entry repeats the one before.
+        assert_eq!(
+            from[..3],
+            [
+                &serde_json::json!([3, 4]),
+                &serde_json::json!([3, 5]),
+                &serde_json::json!([3, 6])
+            ]
+        );
+        for (major, minor) in [(3, 4), (3, 6), (4, 1), (5, 2)] {
+            let v = BlenderVersion { major, minor };
+            let entry = entry_for(&json, major, minor);
+            let own = serde_json::json!({
+                "twin_names": TwinNames::new(v),
+                "predictions": predictions(v),
+            });
+            assert_eq!(entry["twin_names"], own["twin_names"], "{major}.{minor}");
+            assert_eq!(entry["predictions"], own["predictions"], "{major}.{minor}");
+        }
     }
 }
