@@ -15,6 +15,7 @@
 # ---------------------------------------------------------------------------
 import json
 import os
+import textwrap
 
 import bpy
 from bpy.props import (
@@ -41,8 +42,7 @@ VERDICTS = (
 VERDICT_ICONS = {"not-judged": "QUESTION", "ok": "CHECKMARK", "loses": "ERROR",
                  "creates": "ERROR", "error": "CANCEL"}
 # Where the add-on found its catalogue and library (set by register_panel).
-PANEL_STATE = {"directory": None, "catalogue": None, "loaded": False}
-NO_CATALOGUE = "This extension holds no audit catalogue: build it with gloffuse generate --extension"
+PANEL_STATE = {"directory": None, "catalogue": None, "why_not": None, "loaded": False}
 
 
 class GloffuseFinding(bpy.types.PropertyGroup):
@@ -70,9 +70,10 @@ class GloffuseResult(bpy.types.PropertyGroup):
 
 
 def catalogue():
-    """The extension's catalogue, read once; None when it has none."""
+    """The add-on's catalogue, read once; None when it has none for this Blender
+    (PANEL_STATE["why_not"] says why)."""
     if not PANEL_STATE["loaded"]:
-        PANEL_STATE["catalogue"] = load_catalogue(PANEL_STATE["directory"])
+        PANEL_STATE["catalogue"], PANEL_STATE["why_not"] = load_catalogue(PANEL_STATE["directory"])
         PANEL_STATE["loaded"] = True
     return PANEL_STATE["catalogue"]
 
@@ -238,6 +239,27 @@ class GLOFFUSE_OT_show_node(bpy.types.Operator):
 
 # --- panels ------------------------------------------------------------------------
 
+def text_columns(context):
+    """How many characters of UI text fit across the panel's region, or None (no
+    region: a draw outside a window) for no wrapping."""
+    region = getattr(context, "region", None)
+    if region is None or region.width <= 0:
+        return None
+    # ~7 px a character at scale 1, less the panel's and box's margins.
+    return max(16, int(region.width / (7.0 * bpy.context.preferences.system.ui_scale)) - 4)
+
+
+def paragraph(layout, text, columns, icon="NONE"):
+    """`text` as labels of at most `columns` characters (Blender's labels do not
+    wrap, and a narrow sidebar would cut a finding's why and fix short)."""
+    # A word longer than a line stays whole (Blender cuts it), so the lines put
+    # together are the text.
+    lines = textwrap.wrap(text, columns, break_long_words=False, break_on_hyphens=False) \
+        if columns else [text]
+    for n, line in enumerate(lines or [""]):
+        layout.label(text=line, icon=icon if n == 0 else "NONE")
+
+
 def verdict_label(props):
     text = dict((key, name) for key, name, _ in VERDICTS)[props.verdict]
     if props.has_mean:
@@ -245,7 +267,7 @@ def verdict_label(props):
     return text
 
 
-def draw_finding(layout, material, item, editor_tree):
+def draw_finding(layout, material, item, editor_tree, columns):
     box = layout.box()
     row = box.row()
     row.label(text=item.rule, icon="ERROR" if item.effect in FAILING + ("error",) else "INFO")
@@ -254,19 +276,20 @@ def draw_finding(layout, material, item, editor_tree):
         op = row.operator("gloffuse.show_node", text="", icon="ZOOM_SELECTED")
         op.node_path = item.node_path
     column = box.column(align=True)
-    column.label(text=item.node)
+    paragraph(column, item.node, columns)
     if editor_tree is not None and holder is not None and holder != editor_tree:
-        column.label(text="In %s: open it to show the node" % holder.name, icon="NODETREE")
+        paragraph(column, "In %s: open it to show the node" % holder.name, columns, icon="NODETREE")
     if item.has_prediction:
         column.label(text="Predicted %.1f %% for this lobe" % (100.0 * item.predicted))
-    column.label(text="Why: " + item.why)
-    column.label(text="Fix: " + item.fix)
+    paragraph(column, "Why: " + item.why, columns)
+    paragraph(column, "Fix: " + item.fix, columns)
 
 
-def draw_material(layout, material, editor_tree):
-    """The material's verdict, mean, findings and the operators' buttons."""
+def draw_material(layout, material, editor_tree, columns=None):
+    """The material's verdict, mean, findings and the operators' buttons, the
+    long texts wrapped at `columns` characters (None: not wrapped)."""
     if catalogue() is None:
-        layout.label(text=NO_CATALOGUE, icon="ERROR")
+        paragraph(layout, PANEL_STATE["why_not"], columns, icon="ERROR")
         return
     if material is None:
         layout.label(text="No active material")
@@ -274,15 +297,15 @@ def draw_material(layout, material, editor_tree):
     props = material.gloffuse
     layout.label(text=verdict_label(props), icon=VERDICT_ICONS[props.verdict])
     if props.reason:
-        layout.label(text=props.reason)
+        paragraph(layout, props.reason, columns)
     row = layout.row(align=True)
     row.operator("gloffuse.audit_material", icon="VIEWZOOM")
     row.operator("gloffuse.fix_material", icon="MODIFIER")
     layout.operator("gloffuse.audit_file", icon="MATERIAL")
     if props.refusal:
-        layout.label(text="No fix: " + props.refusal, icon="INFO")
+        paragraph(layout, "No fix: " + props.refusal, columns, icon="INFO")
     for item in props.findings:
-        draw_finding(layout, material, item, editor_tree)
+        draw_finding(layout, material, item, editor_tree, columns)
 
 
 def draw_all_materials(layout):
@@ -291,7 +314,7 @@ def draw_all_materials(layout):
     if not materials:
         layout.label(text="No materials")
     for material in materials:
-        row = layout.row()
+        row = layout.split(factor=0.55)
         row.label(text=material.name, icon=VERDICT_ICONS[material.gloffuse.verdict])
         row.label(text=verdict_label(material.gloffuse))
     layout.operator("gloffuse.audit_file", icon="MATERIAL")
@@ -309,7 +332,7 @@ class GLOFFUSE_PT_material(bpy.types.Panel):
         return context_material(context) is not None
 
     def draw(self, context):
-        draw_material(self.layout, context_material(context), None)
+        draw_material(self.layout, context_material(context), None, text_columns(context))
 
 
 class GLOFFUSE_PT_shader_editor(bpy.types.Panel):
@@ -324,7 +347,8 @@ class GLOFFUSE_PT_shader_editor(bpy.types.Panel):
         return getattr(context.space_data, "tree_type", None) == "ShaderNodeTree"
 
     def draw(self, context):
-        draw_material(self.layout, context_material(context), node_editor_tree(context))
+        draw_material(self.layout, context_material(context), node_editor_tree(context),
+                      text_columns(context))
 
 
 class GLOFFUSE_PT_all_materials(bpy.types.Panel):

@@ -15,7 +15,7 @@
 # A module of the gloffuse_blender package, bundled into the extension's
 # __init__.py by the gloffuse binary. Functions and constants only.
 #
-#   load_catalogue(directory) -> the catalogue (dict), or None without one
+#   load_catalogue(directory) -> (the catalogue (dict), None) or (None, why not)
 #   audit_one(catalogue, material) -> {verdict, reason, mean, findings, error, replaced}
 #   fix_one(catalogue, material, library_blend) -> (replaced, refusal or None)
 # ---------------------------------------------------------------------------
@@ -36,20 +36,31 @@ FAILING = ("loses", "creates")
 VERDICT_RANK = {"error": 0, "creates": 1, "loses": 2, "not-judged": 3, "ok": 4}
 
 
+NO_CATALOGUE = "This add-on holds no audit catalogue: build it with gloffuse generate " \
+    "--extension (or --addon)"
+UNSUITED = "This add-on's groups were built by Blender %s for its Cycles, which renders " \
+    "them wrongly here: build it in this Blender (gloffuse generate --addon FILE.zip " \
+    "--blender ...)"
+
+
 def load_catalogue(directory):
-    """The catalogue beside the add-on, as this Blender reads it (the twins' names and
-    predictions of the newest `by_blender` entry not after it), or None: an add-on
-    built without it (by gloffuse's library, not its command line), or by a newer
-    Blender than this one, has no audit."""
+    """(the catalogue beside the add-on as this Blender reads it, None), or (None, why
+    the add-on has no audit here). This Blender reads the twins' names and predictions
+    of the newest `by_blender` entry not after it. None: an add-on built without it (by
+    gloffuse's library, not its command line), or whose groups do not suit this
+    Blender (`suits_before`)."""
     path = os.path.join(directory, CATALOGUE_FILE)
     if not os.path.isfile(path):
-        return None
+        return None, NO_CATALOGUE
     with open(path, encoding="utf-8") as f:
         catalogue = json.load(f)
     mine = [entry for entry in catalogue["by_blender"] if blender_at_least(entry["from"])]
-    if not mine:
-        return None
-    return dict(catalogue, twin_names=mine[-1]["twin_names"], predictions=mine[-1]["predictions"])
+    before = catalogue.get("suits_before")
+    if not mine or (before is not None and blender_at_least(before)):
+        built = catalogue["by_blender"][0]["from"]
+        return None, UNSUITED % ".".join(str(part) for part in built)
+    chosen = mine[-1]
+    return dict(catalogue, twin_names=chosen["twin_names"], predictions=chosen["predictions"]), None
 
 
 def catalogue_rule(catalogue, rule_id):

@@ -21,7 +21,8 @@ FILE.blend ...` (which materials it rewrote) and where it wrote the fixed copies
      oracle's first words) and predictions (within MAX_PREDICTION_ERROR, the
      catalogue's interpolation bound), and as mean the darkest predicted lobe;
   3. each panel's draw() runs with a recording layout (a stand-in for Blender's
-     UILayout that records what is drawn) and shows the verdict and every finding;
+     UILayout that records what is drawn) and shows the verdict and every finding
+     (unwrapped without a region; wrapped, the labels put together are the text);
      the "All materials" list puts failures first; a finding's show-node button is
      drawn only when the editor shows the tree that holds its node;
   4. gloffuse.fix_material on the first material the oracle rewrote, then Blender's
@@ -38,7 +39,9 @@ import argparse
 import json
 import os
 import re
+import shutil
 import sys
+import tempfile
 import traceback
 import types
 
@@ -195,6 +198,25 @@ def install(options, failures, seen):
     return True
 
 
+def check_version_choice(failures, seen):
+    """load_catalogue takes the newest entry not after this Blender, and refuses an
+    add-on whose groups were built for an older masking (a catalogue written here)."""
+    folder = tempfile.mkdtemp()
+    entries = [{"from": [3, 4], "twin_names": "3.4's", "predictions": "3.4's"},
+               {"from": [4, 0], "twin_names": "4.0's", "predictions": "4.0's"}]
+    here = tuple(bpy.app.version[:2])
+    for before, want in ((None, "4.0's" if here >= (4, 0) else "3.4's"),
+                         ([3, 5], None if here >= (3, 5) else "3.4's")):
+        with open(os.path.join(folder, "audit_catalogue.json"), "w", encoding="utf-8") as f:
+            json.dump({"suits_before": before, "by_blender": entries, "rules": []}, f)
+        catalogue, why_not = sys.modules[MODULE].load_catalogue(folder)
+        got = None if catalogue is None else catalogue["twin_names"]
+        seen.setdefault("version_choice", []).append([before, got, why_not])
+        if got != want or (got is None) != (why_not is not None and "built by Blender 3.4" in why_not):
+            failures.append("load_catalogue with suits_before %s: %s, %s (wanted %s)" % (before, got, why_not, want))
+    shutil.rmtree(folder)
+
+
 def swatches():
     """The object every material of the test library sits on, made active."""
     obj = next(o for o in bpy.data.objects if o.type == "MESH" and len(o.material_slots))
@@ -283,6 +305,13 @@ def check_draws(path, oracle, failures, seen):
             for idname in ("gloffuse.audit_material", "gloffuse.fix_material", "gloffuse.audit_file"):
                 if idname not in [e.get("operator") for e in drawn]:
                     failures.append("%s: %s has no %s button" % (material.name, panel.__name__, idname))
+        for item in props.findings:  # a narrow sidebar wraps a long why into several labels
+            recorder = Recorder()
+            sys.modules[MODULE].paragraph(recorder, "Why: " + item.why, 24)
+            lines = labels(recorder.drawn)
+            too_long = [line for line in lines if len(line) > 24 and " " in line]
+            if " ".join(lines) != "Why: " + item.why or too_long or len(lines) < 2:
+                failures.append("%s: wrapped at 24 characters: %s" % (material.name, lines))
     drawn = draw(bpy.types.GLOFFUSE_PT_all_materials, bpy.context)
     listed = [e["label"] for e in drawn if "label" in e and e["label"] in oracle]
     rank = {"error": 0, "creates": 1, "loses": 2, "ok": 4}
@@ -353,6 +382,7 @@ def check(options, seen):
     failures = []
     if not install(options, failures, seen):
         return failures
+    check_version_choice(failures, seen)
     with open(options.oracle, encoding="utf-8") as f:
         report = json.load(f)
     with open(options.fix_report, encoding="utf-8") as f:

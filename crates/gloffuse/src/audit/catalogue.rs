@@ -71,6 +71,9 @@ pub struct Catalogue {
     /// gloffuse.toml may set another for the command line).
     pub tolerance: f64,
     rules: Vec<CatalogueRule>,
+    /// The first Blender the add-on's groups do not suit (3.5 for one built by 3.0–3.4:
+    /// their Cycles corrections fit the masking before it); none: every later one.
+    pub suits_before: Option<[u32; 2]>,
     /// What the panel reads of its Blender, oldest first.
     pub by_blender: Vec<ForBlender>,
 }
@@ -153,8 +156,14 @@ pub fn predictions(version: BlenderVersion) -> Predictions {
     }
 }
 
-/// The entries for Blender `built_with` and every later series, each only where the
-/// twins' names or the predictions change.
+/// The first Blender the groups built by `built_with` do not suit: their Cycles
+/// corrections fit `built_with`'s masking (generate's `suits`).
+fn suits_before(built_with: BlenderVersion) -> Option<BlenderVersion> {
+    (built_with.masking() == Masking::Separable).then_some(BlenderVersion::HEIGHT_CORRELATED_FROM)
+}
+
+/// The entries for Blender `built_with` and every later series its groups suit, each only
+/// where the twins' names or the predictions change.
 fn by_blender(built_with: BlenderVersion) -> Vec<ForBlender> {
     let mut entries: Vec<(String, ForBlender)> = Vec::new();
     // The predictor depends on the Blender only through its masking: two grids at most.
@@ -162,7 +171,7 @@ fn by_blender(built_with: BlenderVersion) -> Vec<ForBlender> {
     let later = SERIES
         .iter()
         .map(|&(major, minor)| BlenderVersion { major, minor })
-        .filter(|&v| v > built_with);
+        .filter(|&v| v > built_with && suits_before(built_with).is_none_or(|end| v < end));
     for version in std::iter::once(built_with).chain(later) {
         let entry = ForBlender {
             from: [version.major, version.minor],
@@ -198,6 +207,7 @@ pub fn catalogue(version: BlenderVersion) -> Catalogue {
                 fix: r.fix,
             })
             .collect(),
+        suits_before: suits_before(version).map(|v| [v.major, v.minor]),
         by_blender: by_blender(version),
     }
 }
@@ -297,24 +307,21 @@ mod tests {
 
     #[test]
     fn every_later_blender_finds_its_own_twins_and_predictions() {
-        let v34 = BlenderVersion { major: 3, minor: 4 };
-        let json: serde_json::Value = serde_json::from_str(&to_json(v34)).unwrap();
+        let v35 = BlenderVersion { major: 3, minor: 5 };
+        let json: serde_json::Value = serde_json::from_str(&to_json(v35)).unwrap();
+        assert_eq!(json["suits_before"], serde_json::Value::Null);
         let from: Vec<&serde_json::Value> = json["by_blender"]
             .as_array()
             .unwrap()
             .iter()
             .map(|e| &e["from"])
             .collect();
-        // 3.5 changes the masking, 3.6 the glass twin; no entry repeats the one before.
+        // 3.6 changes the glass twin; no entry repeats the one before.
         assert_eq!(
-            from[..3],
-            [
-                &serde_json::json!([3, 4]),
-                &serde_json::json!([3, 5]),
-                &serde_json::json!([3, 6])
-            ]
+            from[..2],
+            [&serde_json::json!([3, 5]), &serde_json::json!([3, 6])]
         );
-        for (major, minor) in [(3, 4), (3, 6), (4, 1), (5, 2)] {
+        for (major, minor) in [(3, 5), (3, 6), (4, 1), (5, 2)] {
             let v = BlenderVersion { major, minor };
             let entry = entry_for(&json, major, minor);
             let own = serde_json::json!({
@@ -324,5 +331,14 @@ mod tests {
             assert_eq!(entry["twin_names"], own["twin_names"], "{major}.{minor}");
             assert_eq!(entry["predictions"], own["predictions"], "{major}.{minor}");
         }
+    }
+
+    #[test]
+    fn groups_built_for_the_separable_masking_suit_no_later_blender() {
+        let v34 = BlenderVersion { major: 3, minor: 4 };
+        let json: serde_json::Value = serde_json::from_str(&to_json(v34)).unwrap();
+        assert_eq!(json["suits_before"], serde_json::json!([3, 5]));
+        assert_eq!(json["by_blender"].as_array().unwrap().len(), 1);
+        assert_eq!(json["by_blender"][0]["from"], serde_json::json!([3, 4]));
     }
 }
