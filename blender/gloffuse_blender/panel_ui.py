@@ -335,9 +335,8 @@ class GLOFFUSE_PT_material(bpy.types.Panel):
         draw_material(self.layout, context_material(context), None, text_columns(context))
 
 
-class GLOFFUSE_PT_shader_editor(bpy.types.Panel):
-    bl_label = "Active Material"
-    bl_idname = "GLOFFUSE_PT_shader_editor"
+class ShaderEditorTab:
+    """The Shader Editor sidebar's Gloffuse tab (a mix-in of its panels)."""
     bl_space_type = "NODE_EDITOR"
     bl_region_type = "UI"
     bl_category = "Gloffuse"
@@ -345,22 +344,20 @@ class GLOFFUSE_PT_shader_editor(bpy.types.Panel):
     @classmethod
     def poll(cls, context):
         return getattr(context.space_data, "tree_type", None) == "ShaderNodeTree"
+
+
+class GLOFFUSE_PT_shader_editor(ShaderEditorTab, bpy.types.Panel):
+    bl_label = "Active Material"
+    bl_idname = "GLOFFUSE_PT_shader_editor"
 
     def draw(self, context):
         draw_material(self.layout, context_material(context), node_editor_tree(context),
                       text_columns(context))
 
 
-class GLOFFUSE_PT_all_materials(bpy.types.Panel):
+class GLOFFUSE_PT_all_materials(ShaderEditorTab, bpy.types.Panel):
     bl_label = "All Materials"
     bl_idname = "GLOFFUSE_PT_all_materials"
-    bl_space_type = "NODE_EDITOR"
-    bl_region_type = "UI"
-    bl_category = "Gloffuse"
-
-    @classmethod
-    def poll(cls, context):
-        return getattr(context.space_data, "tree_type", None) == "ShaderNodeTree"
 
     def draw(self, context):
         draw_all_materials(self.layout)

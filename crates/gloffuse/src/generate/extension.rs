@@ -188,6 +188,17 @@ mod tests {
     use super::*;
     use std::io::Read;
 
+    /// The archive and its entries' names, sorted.
+    fn open(bytes: Vec<u8>) -> (zip::ZipArchive<Cursor<Vec<u8>>>, Vec<String>) {
+        let archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+        let mut names: Vec<String> = archive
+            .file_names()
+            .map(|n| n.unwrap().into_owned())
+            .collect();
+        names.sort();
+        (archive, names)
+    }
+
     #[test]
     fn the_archive_holds_the_manifest_addon_and_library() {
         let v45 = BlenderVersion { major: 4, minor: 5 };
@@ -214,12 +225,7 @@ mod tests {
             )
             .unwrap()
         );
-        let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
-        let mut names: Vec<String> = archive
-            .file_names()
-            .map(|n| n.unwrap().into_owned())
-            .collect();
-        names.sort();
+        let (mut archive, names) = open(bytes);
         assert_eq!(
             names,
             [
@@ -265,12 +271,7 @@ mod tests {
     fn the_addon_is_one_folder_whose_init_opens_with_bl_info() {
         let v34 = BlenderVersion { major: 3, minor: 4 };
         let bytes = package(Packaging::Addon, b"BLENDER-fake", "VERSION 1\n", v34, None).unwrap();
-        let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
-        let mut names: Vec<String> = archive
-            .file_names()
-            .map(|n| n.unwrap().into_owned())
-            .collect();
-        names.sort();
+        let (mut archive, names) = open(bytes);
         assert_eq!(
             names,
             [
